@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs everything Lacerta needs on Debian 12 (bookworm) from Debian's packages.
+# Run as root (or through sudo). Safe to run again: apt-get skips what is installed.
+set -euo pipefail
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update
+# libdeal.ii-dev brings Trilinos, CGAL, gmsh, MPI and TBB; the rest are named explicitly
+# because the build or the test suite uses them directly:
+#  numdiff, perl     deal.II's DEAL_II_PICKUP_TESTS compares outputs with numdiff
+#  openmpi-bin       the MPI tests run under mpirun
+#  libvtk9-dev       the VTK mesh reader (.vtk, .vtu)
+#  libcgal-dev       implicit-function organ meshes (GridGenerator::implicit_function)
+#  libeigen3-dev     small dense algebra, eigenvalue checks in tests
+#  libgtest-dev, libbenchmark-dev   unit tests and benchmarks
+#  python3-matplotlib  study plots (error against run time)
+$SUDO apt-get install -y --no-install-recommends \
+  build-essential cmake ninja-build git \
+  libdeal.ii-dev \
+  numdiff perl openmpi-bin libopenmpi-dev \
+  libvtk9-dev libcgal-dev libeigen3-dev \
+  libgtest-dev libbenchmark-dev \
+  clang-format python3 python3-matplotlib

@@ -1,0 +1,80 @@
+/**
+ * @file
+ * Force models: how springs turn positions and velocities into forces (plugins).
+ */
+#pragma once
+
+#include <lacerta/base/plugins.h>
+
+#include <memory>
+#include <string>
+
+namespace lacerta::physics
+{
+  class ParticleSystem;
+
+  /**
+   * A force model evaluates the spring forces of a ParticleSystem. Implementations keep
+   * their own flat, thread-partitioned copy of the springs (made by initialize()), so
+   * the evaluation is one loop without virtual calls per spring.
+   */
+  class ForceModel
+  {
+  public:
+    /// Kind name used in messages and in the documentation.
+    static std::string
+    plugin_kind()
+    {
+      return "force model";
+    }
+
+    virtual ~ForceModel() = default;
+
+    /// Reads the plugin's parameters from its subsection.
+    virtual void
+    parse_parameters(dealii::ParameterHandler &prm);
+
+    /**
+     * Prepares the evaluation for the system's current springs on @p n_threads threads.
+     * Must be called again when the springs change (cuts).
+     */
+    virtual void
+    initialize(const ParticleSystem &system, unsigned int n_threads) = 0;
+
+    /**
+     * Accelerations: spring forces plus the system's loads and particle damping,
+     * divided by the masses, zero for constrained particles.
+     */
+    virtual void
+    compute_acceleration(const ParticleSystem &system,
+                         const double         *x,
+                         const double         *v,
+                         double               *a) const = 0;
+
+    /// Spring forces (including damping along springs) on every particle.
+    virtual void
+    compute_spring_forces(const ParticleSystem &system,
+                          const double         *x,
+                          const double         *v,
+                          double               *f) const = 0;
+
+    /// Elastic energy stored in the springs at positions @p x.
+    virtual double
+    elastic_energy(const ParticleSystem &system, const double *x) const = 0;
+
+    /// Declares `subsection Force model` with the `Model` selector.
+    static void
+    declare_parameters(dealii::ParameterHandler &prm);
+
+    /// Creates the model selected in `subsection Force model`.
+    static std::unique_ptr<ForceModel>
+    create(dealii::ParameterHandler &prm);
+  };
+
+  /// The registry of force models.
+  using ForceModelRegistry = PluginRegistry<ForceModel>;
+} // namespace lacerta::physics
+
+/// Registers a force model plugin.
+#define LACERTA_REGISTER_FORCE_MODEL(classname, name, description) \
+  LACERTA_REGISTER_PLUGIN(lacerta::physics::ForceModel, classname, name, description)

@@ -1,0 +1,110 @@
+/**
+ * @file
+ * The particle system (Section 3): state, masses, springs, loads and constraints.
+ */
+#pragma once
+
+#include <lacerta/physics/spring_set.h>
+
+#include <array>
+#include <functional>
+#include <memory>
+#include <vector>
+
+namespace lacerta::physics
+{
+  class ForceModel;
+
+  /**
+   * Everything the integrators advance: positions and velocities (3 doubles per
+   * particle, interleaved), masses, springs, damping, loads and which particles move
+   * freely. Particles are indexed by mesh vertex id.
+   *
+   * The equations of motion are M x'' = f_springs(x, x') + M g + f_ext - c M x' for the
+   * free particles; the constrained ones follow the motion the scene prescribes.
+   */
+  class ParticleSystem
+  {
+  public:
+    /// Positions, 3 per particle.
+    std::vector<double> position;
+    /// Velocities, 3 per particle.
+    std::vector<double> velocity;
+    /// Lumped masses (kg).
+    std::vector<double> mass;
+    /// 1 for a free particle, 0 for one whose motion is prescribed.
+    std::vector<double> free;
+    /// External forces (N), 3 per particle; set by the scene's force handles.
+    std::vector<double> external_force;
+    /// The springs (Section 3.2).
+    SpringSet springs;
+    /// Uniform body acceleration, e.g. gravity (m/s²).
+    std::array<double, 3> body_acceleration = {{0, 0, 0}};
+    /// Viscous damping per particle, force -c m v (1/s).
+    double mass_damping = 0;
+    /// Damping along springs, force -β k ((v_b - v_a)·n) n (s).
+    double spring_damping = 0;
+
+    /**
+     * Called by the integrators at the end of every (sub)step to put the constrained
+     * particles where the scene prescribes them at time t: (t, positions, velocities).
+     */
+    std::function<void(double, double *, double *)> enforce_constraints;
+
+    /// Wall time spent in compute_acceleration() since it was last reset (s).
+    mutable double force_seconds = 0;
+
+    /// Creates @p n_particles particles at rest at @p rest_positions (3 per particle).
+    ParticleSystem(const std::vector<double> &rest_positions);
+
+    ~ParticleSystem();
+
+    /// Number of particles.
+    unsigned int
+    n_particles() const
+    {
+      return static_cast<unsigned int>(mass.size());
+    }
+
+    /// Sets the force model; it is initialised for the current springs.
+    void
+    set_force_model(std::unique_ptr<ForceModel> model, unsigned int n_threads);
+
+    /// The force model.
+    const ForceModel &
+    force_model() const
+    {
+      return *forces;
+    }
+
+    /**
+     * Accelerations a(x, v) at state (x, v): spring forces, damping, loads, divided by
+     * the masses; zero for constrained particles. No allocation.
+     */
+    void
+    compute_acceleration(const double *x, const double *v, double *a) const;
+
+    /// Kinetic energy ½ Σ m |v|² of the current state.
+    double
+    kinetic_energy() const;
+
+    /// Potential energy of the body force, -Σ m g·(x - x_rest) (J).
+    double
+    body_force_energy() const;
+
+    /// Elastic energy of the springs at the current positions.
+    double
+    elastic_energy() const;
+
+    /// Rest positions the system was created with.
+    const std::vector<double> &
+    rest_position() const
+    {
+      return rest;
+    }
+
+  private:
+    std::vector<double>         rest;
+    std::unique_ptr<ForceModel> forces;
+  };
+} // namespace lacerta::physics

@@ -1,0 +1,51 @@
+/**
+ * @file
+ * The springs of the particle system as flat arrays.
+ */
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+namespace lacerta::physics
+{
+  /**
+   * Springs as a structure of arrays: spring s joins particles a[s] and b[s], has
+   * stiffness[s] (N/m) and rest_length[s] (m). The hot loop reads these arrays
+   * sequentially.
+   */
+  struct SpringSet
+  {
+    std::vector<unsigned int> a;
+    std::vector<unsigned int> b;
+    std::vector<double>       stiffness;
+    std::vector<double>       rest_length;
+
+    /// Number of springs.
+    std::size_t
+    size() const
+    {
+      return a.size();
+    }
+
+    /// Appends a spring.
+    void
+    push_back(unsigned int first, unsigned int second, double k, double length)
+    {
+      a.push_back(first);
+      b.push_back(second);
+      stiffness.push_back(k);
+      rest_length.push_back(length);
+    }
+
+    /// Removes all springs.
+    void
+    clear()
+    {
+      a.clear();
+      b.clear();
+      stiffness.clear();
+      rest_length.clear();
+    }
+  };
+} // namespace lacerta::physics

@@ -1,0 +1,89 @@
+/**
+ * @file
+ * Stability control: a bound on the highest eigenfrequency, and blow-up detection.
+ */
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace lacerta::physics
+{
+  class ParticleSystem;
+
+  /**
+   * An upper bound on the highest angular eigenfrequency of M⁻¹K and where it comes
+   * from.
+   */
+  struct FrequencyBound
+  {
+    /// Bound on the highest angular eigenfrequency ω (rad/s); 0 if nothing moves.
+    double omega = 0;
+    /// The free particle whose Gershgorin disc gives the bound.
+    unsigned int particle = 0;
+    /// The stiffest spring (index into the system's springs) at that particle.
+    unsigned int spring = 0;
+  };
+
+  /**
+   * Bounds the highest eigenvalue of M^-1/2 K M^-1/2 by block Gershgorin over the free
+   * particles: λ ≤ max_i [λ_max(Σ_e K_e / m_i) + Σ_e ||K_e|| / sqrt(m_i m_j)], with the
+   * tangent stiffness of each spring at the current positions,
+   * K_e = k n nᵀ + k (1 - L0/L)(I - n nᵀ), whose geometric part matters for strongly
+   * compressed springs. Constrained particles do not move and drop out.
+   */
+  FrequencyBound
+  bound_highest_frequency(const ParticleSystem &system);
+
+  /**
+   * Describes spring @p s of @p system for messages: its particles, rest positions,
+   * stiffness and length.
+   */
+  std::string
+  describe_spring(const ParticleSystem &system, unsigned int s);
+
+  /**
+   * Watches a run for blow-ups: positions or velocities that are not finite, and
+   * mechanical energy that grows beyond the work done on the system by prescribed
+   * motions and external forces. check() throws a lacerta::Error that names the step,
+   * the time and the place.
+   */
+  class BlowUpMonitor
+  {
+  public:
+    /**
+     * Starts watching @p system from its current state; @p tolerance is the allowed
+     * energy excess relative to the system's energy scale.
+     */
+    BlowUpMonitor(const ParticleSystem &system, double tolerance);
+
+    /**
+     * Checks the current state after step @p step, at time @p time. Also accumulates
+     * the work done by the loads since the last check.
+     */
+    void
+    check(const ParticleSystem &system, unsigned int step, double time);
+
+    /// Work done on the system by prescribed motions and external forces so far (J).
+    double
+    input_work() const
+    {
+      return work;
+    }
+
+  private:
+    /// Fills `load` with the force each load exerts on the particles at @p system's
+    /// state.
+    void
+    compute_load_forces(const ParticleSystem &system);
+
+    double              tolerance;
+    double              initial_energy;
+    double              energy_scale;
+    double              energy_floor;
+    double              work = 0;
+    std::vector<double> previous_position;
+    std::vector<double> previous_load;
+    std::vector<double> load;
+  };
+} // namespace lacerta::physics

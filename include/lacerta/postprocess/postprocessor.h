@@ -1,0 +1,107 @@
+/**
+ * @file
+ * Postprocessors: what a run writes (plugins, `subsection Postprocess`).
+ */
+#pragma once
+
+#include <lacerta/base/plugins.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace lacerta::mesh
+{
+  class TetMesh;
+}
+namespace lacerta::physics
+{
+  class ParticleSystem;
+}
+namespace lacerta::scene
+{
+  class Material;
+}
+
+namespace lacerta::postprocess
+{
+  /**
+   * What a postprocessor sees after a step.
+   */
+  struct RunState
+  {
+    const mesh::TetMesh           *mesh     = nullptr;
+    const physics::ParticleSystem *system   = nullptr;
+    const scene::Material         *material = nullptr;
+    /// Step number (0 before the first step).
+    unsigned int step = 0;
+    /// Simulated time (s).
+    double time = 0;
+    /// Time step of this step and the number of sub-steps it was split into.
+    double       time_step = 0;
+    unsigned int substeps  = 1;
+    /// Energies (J) and the work done by the loads since the start (J).
+    double kinetic_energy = 0, elastic_energy = 0, body_force_energy = 0, input_work = 0;
+    /// Wall time of this step's force evaluations and of the whole step (s).
+    double force_seconds = 0, step_seconds = 0;
+  };
+
+
+  /**
+   * A postprocessor writes something about the run after every step (or every few).
+   */
+  class Postprocessor
+  {
+  public:
+    /// Kind name used in messages and in the documentation.
+    static std::string
+    plugin_kind()
+    {
+      return "postprocessor";
+    }
+
+    virtual ~Postprocessor() = default;
+
+    /// Reads the plugin's parameters from its subsection.
+    virtual void
+    parse_parameters(dealii::ParameterHandler &prm) = 0;
+
+    /**
+     * Prepares output into @p output_directory; in @p test_mode nothing that depends
+     * on the machine (wall times) is written.
+     */
+    virtual void
+    initialize(const std::string &output_directory, bool test_mode) = 0;
+
+    /// Whether execute() at time @p time needs the energies of the state.
+    virtual bool
+    needs_energies(double time) const;
+
+    /// Whether execute() at time @p time writes the state (it is checked for blow-up
+    /// first).
+    virtual bool
+    writes_state(double time) const;
+
+    /// Called after every step (and once before the first, with step 0).
+    virtual void
+    execute(const RunState &state) = 0;
+
+    /// Declares `subsection Postprocess` with the list and every plugin's subsection.
+    static void
+    declare_parameters(dealii::ParameterHandler &prm);
+
+    /// Creates the postprocessors listed in `subsection Postprocess`.
+    static std::vector<std::unique_ptr<Postprocessor>>
+    create(dealii::ParameterHandler &prm);
+  };
+
+  /// The registry of postprocessors.
+  using PostprocessorRegistry = PluginRegistry<Postprocessor>;
+} // namespace lacerta::postprocess
+
+/// Registers a postprocessor plugin.
+#define LACERTA_REGISTER_POSTPROCESSOR(classname, name, description) \
+  LACERTA_REGISTER_PLUGIN(lacerta::postprocess::Postprocessor,       \
+                          classname,                                 \
+                          name,                                      \
+                          description)

@@ -1,0 +1,102 @@
+/**
+ * @file
+ * Constraints on regions of the object: fixed, moved along a path, or pulled by a force
+ * (plugins, `subsection Constraints`).
+ */
+#pragma once
+
+#include <lacerta/base/plugins.h>
+#include <lacerta/mesh/tet_mesh.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace lacerta::physics
+{
+  class ParticleSystem;
+}
+
+namespace lacerta::scene
+{
+  /**
+   * A constraint acts on the particles of a region: it prescribes their motion (they
+   * are then not free) or applies forces to them.
+   *
+   * A scene names its constraints in `subsection Constraints`, `set Names = a, b`; each
+   * has a subsection of that name with `Type` (the plugin), `Region` (a region plugin)
+   * and the plugins' own subsections.
+   */
+  class Constraint
+  {
+  public:
+    /// Kind name used in messages and in the documentation.
+    static std::string
+    plugin_kind()
+    {
+      return "constraint";
+    }
+
+    virtual ~Constraint() = default;
+
+    /// Reads the plugin's parameters from its subsection.
+    virtual void
+    parse_parameters(dealii::ParameterHandler &prm) = 0;
+
+    /**
+     * Takes the particles it acts on; constraints that prescribe motion mark them as
+     * not free in @p system.
+     */
+    virtual void
+    initialize(const std::vector<unsigned int> &particles,
+               physics::ParticleSystem         &system);
+
+    /// Whether the constraint prescribes the motion of its particles.
+    virtual bool
+    prescribes_motion() const = 0;
+
+    /**
+     * Writes the prescribed positions and velocities at time @p t into @p x and @p v
+     * (3 values per particle), given the rest positions @p rest.
+     */
+    virtual void
+    prescribe(double t, const double *rest, double *x, double *v) const;
+
+    /// Adds the forces the constraint applies at time @p t to the system's external
+    /// forces.
+    virtual void
+    add_forces(double t, physics::ParticleSystem &system) const;
+
+    /// The instance's name in the parameter file.
+    std::string name;
+    /// The particles the constraint acts on.
+    std::vector<unsigned int> particles;
+
+    /**
+     * Declares `subsection Constraints` with `Names` and, for every name, its
+     * subsection with `Type`, `Region` and the subsections of all constraint and
+     * region plugins.
+     */
+    static void
+    declare_parameters(dealii::ParameterHandler       &prm,
+                       const std::vector<std::string> &names);
+
+    /// The instance names listed in `Constraints/Names`.
+    static std::vector<std::string>
+    names(dealii::ParameterHandler &prm);
+
+    /**
+     * Creates every named constraint with its region's particles in @p mesh. A region
+     * that selects no particle is an Error naming the constraint.
+     */
+    static std::vector<std::unique_ptr<Constraint>>
+    create(dealii::ParameterHandler &prm, const mesh::TetMesh &mesh);
+  };
+
+  /// The registry of constraints.
+  using ConstraintRegistry = PluginRegistry<Constraint>;
+} // namespace lacerta::scene
+
+/// Registers a constraint plugin.
+#define LACERTA_REGISTER_CONSTRAINT(classname, name, description) \
+  LACERTA_REGISTER_PLUGIN(lacerta::scene::Constraint, classname, name, description)

@@ -1,0 +1,54 @@
+/**
+ * @file
+ * The material of the object: density and Young's modulus fields, damping.
+ */
+#pragma once
+
+#include <deal.II/base/function_parser.h>
+#include <deal.II/base/parameter_handler.h>
+
+#include <memory>
+
+namespace lacerta::scene
+{
+  /**
+   * Density σ(x) and Young's modulus E(x) as FunctionParser expressions of x, y, z
+   * (`subsection Material`), the Poisson ratio for the FEM reference, and damping.
+   */
+  class Material
+  {
+  public:
+    /// Declares `subsection Material`.
+    static void
+    declare_parameters(dealii::ParameterHandler &prm);
+
+    /// Reads `subsection Material`; an expression that does not parse is an Error.
+    void
+    parse_parameters(dealii::ParameterHandler &prm);
+
+    /// Density σ(x) in kg/m³.
+    const dealii::Function<3> &
+    density() const
+    {
+      return *density_function;
+    }
+
+    /// Young's modulus E(x) in Pa.
+    const dealii::Function<3> &
+    youngs_modulus() const
+    {
+      return *youngs_function;
+    }
+
+    /// Poisson ratio (used by the FEM reference; springs behave as ν = 1/4).
+    double poisson_ratio = 0.25;
+    /// Viscous damping per particle (1/s).
+    double mass_damping = 0;
+    /// Damping along springs (s).
+    double spring_damping = 0;
+
+  private:
+    std::unique_ptr<dealii::FunctionParser<3>> density_function;
+    std::unique_ptr<dealii::FunctionParser<3>> youngs_function;
+  };
+} // namespace lacerta::scene

@@ -1,0 +1,27 @@
+#include <lacerta/base/parameter_utilities.h>
+
+#include <deal.II/base/utilities.h>
+
+namespace lacerta
+{
+  void
+  declare_point_entry(dealii::ParameterHandler &prm,
+                      const std::string        &name,
+                      const std::string        &default_value,
+                      const std::string        &documentation)
+  {
+    prm.declare_entry(name,
+                      default_value,
+                      dealii::Patterns::List(dealii::Patterns::Double(), 3, 3, ","),
+                      documentation + " Three numbers separated by commas.");
+  }
+
+
+  std::array<double, 3>
+  get_point(const dealii::ParameterHandler &prm, const std::string &name)
+  {
+    const std::vector<double> values = dealii::Utilities::string_to_double(
+      dealii::Utilities::split_string_list(prm.get(name), ','));
+    return {values[0], values[1], values[2]};
+  }
+} // namespace lacerta

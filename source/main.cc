@@ -1,0 +1,58 @@
+// lacerta: runs a scene described by a parameter file.
+
+#include <lacerta/base/exceptions.h>
+#include <lacerta/simulator/simulator.h>
+
+#include <deal.II/base/exceptions.h>
+#include <deal.II/base/mpi.h>
+
+#include <iostream>
+
+int
+main(int argc, char **argv)
+{
+  dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv);
+  dealii::deal_II_exceptions::disable_abort_on_exception();
+  dealii::deal_II_exceptions::suppress_stacktrace_in_exceptions();
+
+  const std::string first = argc > 1 ? argv[1] : "";
+  if (first == "--help" || first == "-h")
+  {
+    lacerta::Simulator::print_help(std::cout);
+    return 0;
+  }
+  if (argc != 2)
+  {
+    std::cerr << "Usage: lacerta <scene.prm>   (lacerta --help prints every parameter)\n";
+    return 2;
+  }
+
+  try
+  {
+    dealii::ParameterHandler prm;
+    lacerta::Simulator::read_parameters(argv[1], prm);
+    lacerta::Simulator simulator(prm, argv[1]);
+    simulator.run();
+  }
+  catch (const lacerta::Error &e)
+  {
+    std::cout.flush();
+    std::cerr << "\nError: " << e.what() << std::endl;
+    return 1;
+  }
+  catch (const dealii::ExceptionBase &e)
+  {
+    std::cout.flush();
+    std::cerr << "\nError: ";
+    e.print_info(std::cerr);
+    std::cerr << std::endl;
+    return 1;
+  }
+  catch (const std::exception &e)
+  {
+    std::cout.flush();
+    std::cerr << "\nError: " << e.what() << std::endl;
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,413 @@
+#include <lacerta/base/exceptions.h>
+#include <lacerta/mesh/tet_mesh.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace lacerta::mesh
+{
+  double
+  signed_volume(const Point3 &a, const Point3 &b, const Point3 &c, const Point3 &d)
+  {
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+            + u[2] * (v[0] * w[1] - v[1] * w[0]))
+           / 6.0;
+  }
+
+
+  namespace
+  {
+    std::string
+    describe_point(const Point3 &p)
+    {
+      std::ostringstream s;
+      s.precision(8);
+      s << "(" << p[0] << ", " << p[1] << ", " << p[2] << ")";
+      return s.str();
+    }
+
+
+    double
+    longest_edge(const std::vector<Point3> &vertices, const Tet &t)
+    {
+      double longest = 0;
+      for (const auto &e : TetMesh::edge_vertices)
+      {
+        const Point3 &a = vertices[t[e[0]]];
+        const Point3 &b = vertices[t[e[1]]];
+        longest = std::max(longest, std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]));
+      }
+      return longest;
+    }
+
+
+    /// Sorted copy of three ids, the key that identifies a face from either side.
+    std::array<unsigned int, 3>
+    sorted(std::array<unsigned int, 3> ids)
+    {
+      std::sort(ids.begin(), ids.end());
+      return ids;
+    }
+  } // namespace
+
+
+  TetMesh::TetMesh(std::vector<Point3>         vertices_in,
+                   std::vector<Tet>            tets_in,
+                   const std::string          &source,
+                   const std::vector<FaceTag> &tags)
+      : vertices(std::move(vertices_in))
+      , tets(std::move(tets_in))
+      , source_name(source)
+  {
+    if (tets.empty())
+      throw_error("Mesh '", source_name, "' has no tetrahedra.");
+
+    for (unsigned int v = 0; v < vertices.size(); ++v)
+      for (const double x : vertices[v])
+        if (!std::isfinite(x))
+          throw_error("Mesh '",
+                      source_name,
+                      "': vertex ",
+                      v,
+                      " has a coordinate that is not a finite number ",
+                      describe_point(vertices[v]),
+                      ".");
+
+    for (unsigned int t = 0; t < tets.size(); ++t)
+    {
+      Tet &cell = tets[t];
+      for (unsigned int i = 0; i < 4; ++i)
+      {
+        if (cell[i] >= vertices.size())
+          throw_error("Mesh '",
+                      source_name,
+                      "': cell ",
+                      t,
+                      " refers to vertex ",
+                      cell[i],
+                      " but the mesh has only ",
+                      vertices.size(),
+                      " vertices.");
+        for (unsigned int j = 0; j < i; ++j)
+          if (cell[i] == cell[j])
+            throw_error("Mesh '",
+                        source_name,
+                        "': cell ",
+                        t,
+                        " is degenerate: it repeats vertex ",
+                        cell[i],
+                        " at ",
+                        describe_point(vertices[cell[i]]),
+                        ".");
+      }
+      double       volume = signed_volume(vertices[cell[0]],
+                                    vertices[cell[1]],
+                                    vertices[cell[2]],
+                                    vertices[cell[3]]);
+      const double h      = longest_edge(vertices, cell);
+      // A tetrahedron whose volume is negligible against the cube of its longest edge
+      // has no stiffness across its height and would make the time step collapse.
+      if (std::abs(volume) <= 1e-12 * h * h * h)
+        throw_error("Mesh '",
+                    source_name,
+                    "': cell ",
+                    t,
+                    " is degenerate: its volume is zero (vertices ",
+                    cell[0],
+                    ", ",
+                    cell[1],
+                    ", ",
+                    cell[2],
+                    ", ",
+                    cell[3],
+                    " at ",
+                    describe_point(vertices[cell[0]]),
+                    ").");
+      if (volume < 0)
+        std::swap(cell[2], cell[3]);
+    }
+
+    // Vertices no tetrahedron uses (nodes of surface elements only, say) would be
+    // particles without mass: drop them.
+    std::vector<unsigned int> compact(vertices.size(), invalid_index);
+    unsigned int              n_used = 0;
+    for (const Tet &cell : tets)
+      for (const unsigned int v : cell)
+        if (compact[v] == invalid_index)
+          compact[v] = n_used++;
+    if (n_used < vertices.size())
+    {
+      std::vector<Point3> used(n_used);
+      for (unsigned int v = 0; v < vertices.size(); ++v)
+        if (compact[v] != invalid_index)
+          used[compact[v]] = vertices[v];
+      vertices = std::move(used);
+      for (Tet &cell : tets)
+        for (unsigned int &v : cell)
+          v = compact[v];
+    }
+    std::vector<FaceTag> used_tags;
+    for (const FaceTag &tag : tags)
+      if (tag.vertices[0] < compact.size() && tag.vertices[1] < compact.size()
+          && tag.vertices[2] < compact.size() && compact[tag.vertices[0]] != invalid_index
+          && compact[tag.vertices[1]] != invalid_index
+          && compact[tag.vertices[2]] != invalid_index)
+        used_tags.push_back(
+          {{compact[tag.vertices[0]], compact[tag.vertices[1]], compact[tag.vertices[2]]},
+           tag.boundary_id});
+
+    build_connectivity(used_tags);
+  }
+
+
+  void
+  TetMesh::build_connectivity(const std::vector<FaceTag> &tags)
+  {
+    const unsigned int n_tets = tets.size();
+
+    // Faces: sort (key, owner) so that the two sides of an interior face are adjacent.
+    struct FaceEntry
+    {
+      std::array<unsigned int, 3> key;
+      unsigned int                owner; // 4 * tet + local face
+    };
+    std::vector<FaceEntry> faces(4 * n_tets);
+    for (unsigned int t = 0; t < n_tets; ++t)
+      for (unsigned int f = 0; f < 4; ++f)
+        faces[4 * t + f] = {sorted({tets[t][face_vertices[f][0]],
+                                    tets[t][face_vertices[f][1]],
+                                    tets[t][face_vertices[f][2]]}),
+                            4 * t + f};
+    std::sort(faces.begin(),
+              faces.end(),
+              [](const FaceEntry &a, const FaceEntry &b)
+              { return a.key < b.key || (a.key == b.key && a.owner < b.owner); });
+
+    std::vector<FaceTag> sorted_tags = tags;
+    for (auto &tag : sorted_tags)
+      tag.vertices = sorted(tag.vertices);
+    std::sort(sorted_tags.begin(),
+              sorted_tags.end(),
+              [](const FaceTag &a, const FaceTag &b) { return a.vertices < b.vertices; });
+
+    neighbors.assign(4 * n_tets, invalid_index);
+    boundary_faces.clear();
+    for (std::size_t i = 0; i < faces.size();)
+    {
+      std::size_t j = i + 1;
+      while (j < faces.size() && faces[j].key == faces[i].key)
+        ++j;
+      if (j - i > 2)
+        throw_error("Mesh '",
+                    source_name,
+                    "' is not a manifold: the face with vertices ",
+                    faces[i].key[0],
+                    ", ",
+                    faces[i].key[1],
+                    ", ",
+                    faces[i].key[2],
+                    " is shared by ",
+                    j - i,
+                    " cells (cells ",
+                    faces[i].owner / 4,
+                    ", ",
+                    faces[i + 1].owner / 4,
+                    ", ",
+                    faces[i + 2].owner / 4,
+                    ").");
+      if (j - i == 2)
+      {
+        neighbors[faces[i].owner]     = faces[i + 1].owner / 4;
+        neighbors[faces[i + 1].owner] = faces[i].owner / 4;
+      }
+      else
+      {
+        const auto tag =
+          std::lower_bound(sorted_tags.begin(),
+                           sorted_tags.end(),
+                           faces[i].key,
+                           [](const FaceTag &a, const std::array<unsigned int, 3> &key)
+                           { return a.vertices < key; });
+        const unsigned int id =
+          (tag != sorted_tags.end() && tag->vertices == faces[i].key) ? tag->boundary_id
+                                                                      : 0;
+        boundary_faces.push_back({faces[i].owner / 4, faces[i].owner % 4, id});
+      }
+      i = j;
+    }
+    std::sort(boundary_faces.begin(),
+              boundary_faces.end(),
+              [](const BoundaryFace &a, const BoundaryFace &b)
+              { return a.tet < b.tet || (a.tet == b.tet && a.face < b.face); });
+
+    boundary_vertex.assign(vertices.size(), 0);
+    for (const BoundaryFace &bf : boundary_faces)
+      for (const unsigned int lv : face_vertices[bf.face])
+        boundary_vertex[tets[bf.tet][lv]] = 1;
+
+    // Edges: the same trick with (sorted pair, owner).
+    std::vector<std::pair<std::array<unsigned int, 2>, unsigned int>> edge_list(6
+                                                                                * n_tets);
+    for (unsigned int t = 0; t < n_tets; ++t)
+      for (unsigned int e = 0; e < 6; ++e)
+      {
+        unsigned int a = tets[t][edge_vertices[e][0]];
+        unsigned int b = tets[t][edge_vertices[e][1]];
+        if (a > b)
+          std::swap(a, b);
+        edge_list[6 * t + e] = {{{a, b}}, 6 * t + e};
+      }
+    std::sort(edge_list.begin(), edge_list.end());
+    edges.clear();
+    tet_edge_ids.assign(n_tets, {});
+    for (const auto &[key, owner] : edge_list)
+    {
+      if (edges.empty() || edges.back() != key)
+        edges.push_back(key);
+      tet_edge_ids[owner / 6][owner % 6] = edges.size() - 1;
+    }
+  }
+
+
+  double
+  TetMesh::volume(const unsigned int t) const
+  {
+    const Tet &c = tets[t];
+    return signed_volume(vertices[c[0]], vertices[c[1]], vertices[c[2]], vertices[c[3]]);
+  }
+
+
+  double
+  TetMesh::total_volume() const
+  {
+    double sum = 0;
+    for (unsigned int t = 0; t < tets.size(); ++t)
+      sum += volume(t);
+    return sum;
+  }
+
+
+  std::array<double, 2>
+  TetMesh::edge_length_range() const
+  {
+    std::array<double, 2> range = {std::numeric_limits<double>::max(), 0.0};
+    for (const auto &e : edges)
+    {
+      const Point3 &a = vertices[e[0]];
+      const Point3 &b = vertices[e[1]];
+      const double  l = std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+      range[0]        = std::min(range[0], l);
+      range[1]        = std::max(range[1], l);
+    }
+    return range;
+  }
+
+
+  namespace
+  {
+    /// Spreads the lower 21 bits of x so that two zero bits follow each bit.
+    std::uint64_t
+    spread_bits(std::uint64_t x)
+    {
+      x &= 0x1fffff;
+      x = (x | x << 32) & 0x1f00000000ffffULL;
+      x = (x | x << 16) & 0x1f0000ff0000ffULL;
+      x = (x | x << 8) & 0x100f00f00f00f00fULL;
+      x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+      x = (x | x << 2) & 0x1249249249249249ULL;
+      return x;
+    }
+
+
+    /// Morton keys of points in the bounding box of @p points.
+    std::vector<std::uint64_t>
+    morton_keys(const std::vector<Point3> &points)
+    {
+      Point3 lo = points[0], hi = points[0];
+      for (const Point3 &p : points)
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          lo[d] = std::min(lo[d], p[d]);
+          hi[d] = std::max(hi[d], p[d]);
+        }
+      const double extent =
+        std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
+      std::vector<std::uint64_t> keys(points.size());
+      for (std::size_t i = 0; i < points.size(); ++i)
+      {
+        std::uint64_t key = 0;
+        for (unsigned int d = 0; d < 3; ++d)
+          key |= spread_bits(static_cast<std::uint64_t>((points[i][d] - lo[d]) / extent
+                                                        * double((1 << 21) - 1)))
+                 << d;
+        keys[i] = key;
+      }
+      return keys;
+    }
+
+
+    /// The permutation that sorts @p keys (stable, so ties keep the input order).
+    std::vector<unsigned int>
+    sorting_permutation(const std::vector<std::uint64_t> &keys)
+    {
+      std::vector<unsigned int> order(keys.size());
+      std::iota(order.begin(), order.end(), 0u);
+      std::stable_sort(order.begin(),
+                       order.end(),
+                       [&](unsigned int a, unsigned int b) { return keys[a] < keys[b]; });
+      return order;
+    }
+  } // namespace
+
+
+  std::vector<unsigned int>
+  TetMesh::sort_spatially()
+  {
+    // Keep the boundary ids across the renumbering.
+    std::vector<FaceTag> tags;
+    for (const BoundaryFace &bf : boundary_faces)
+      if (bf.boundary_id != 0)
+        tags.push_back({{tets[bf.tet][face_vertices[bf.face][0]],
+                         tets[bf.tet][face_vertices[bf.face][1]],
+                         tets[bf.tet][face_vertices[bf.face][2]]},
+                        bf.boundary_id});
+
+    const std::vector<unsigned int> vertex_order =
+      sorting_permutation(morton_keys(vertices));
+    std::vector<unsigned int> new_index(vertices.size());
+    std::vector<Point3>       new_vertices(vertices.size());
+    for (unsigned int i = 0; i < vertex_order.size(); ++i)
+    {
+      new_index[vertex_order[i]] = i;
+      new_vertices[i]            = vertices[vertex_order[i]];
+    }
+    vertices = std::move(new_vertices);
+    for (Tet &t : tets)
+      for (unsigned int &v : t)
+        v = new_index[v];
+    for (FaceTag &tag : tags)
+      for (unsigned int &v : tag.vertices)
+        v = new_index[v];
+
+    std::vector<Point3> centroids(tets.size());
+    for (unsigned int t = 0; t < tets.size(); ++t)
+      for (unsigned int d = 0; d < 3; ++d)
+        centroids[t][d] = 0.25
+                          * (vertices[tets[t][0]][d] + vertices[tets[t][1]][d]
+                             + vertices[tets[t][2]][d] + vertices[tets[t][3]][d]);
+    const std::vector<unsigned int> tet_order =
+      sorting_permutation(morton_keys(centroids));
+    std::vector<Tet> new_tets(tets.size());
+    for (unsigned int i = 0; i < tet_order.size(); ++i)
+      new_tets[i] = tets[tet_order[i]];
+    tets = std::move(new_tets);
+
+    build_connectivity(tags);
+    return new_index;
+  }
+} // namespace lacerta::mesh

@@ -1,0 +1,55 @@
+#include <lacerta/physics/integrator.h>
+
+#include <cmath>
+
+namespace lacerta::physics
+{
+  void
+  Integrator::parse_parameters(dealii::ParameterHandler &)
+  {
+  }
+
+
+  void
+  Integrator::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection("Integrator");
+    IntegratorRegistry::declare_selector(
+      prm,
+      "Scheme",
+      "rk4",
+      "The explicit time integration scheme. Its stable "
+      "time step is printed before the run (see "
+      "doc/stability.md).");
+    IntegratorRegistry::declare_all_in_subsections(prm);
+    prm.leave_subsection();
+  }
+
+
+  std::unique_ptr<Integrator>
+  Integrator::create(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection("Integrator");
+    auto integrator = IntegratorRegistry::create_and_parse(prm.get("Scheme"), prm);
+    prm.leave_subsection();
+    return integrator;
+  }
+
+
+  double
+  modal_damping(const double omega,
+                const double mass_damping,
+                const double spring_damping)
+  {
+    return mass_damping + spring_damping * omega * omega;
+  }
+
+
+  double
+  symplectic_critical_time_step(const double omega, const double c)
+  {
+    // Jury conditions on the amplification matrix [[1 - ω²dt², dt(1 - c dt)],
+    // [-ω²dt, 1 - c dt]]: trace > -(1 + det) gives ω²dt² + 2c dt < 4.
+    return (std::sqrt(c * c + 4.0 * omega * omega) - c) / (omega * omega);
+  }
+} // namespace lacerta::physics

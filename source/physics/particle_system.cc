@@ -1,0 +1,70 @@
+#include <lacerta/physics/force_model.h>
+#include <lacerta/physics/particle_system.h>
+
+#include <chrono>
+
+namespace lacerta::physics
+{
+  ParticleSystem::ParticleSystem(const std::vector<double> &rest_positions)
+      : position(rest_positions)
+      , velocity(rest_positions.size(), 0.0)
+      , mass(rest_positions.size() / 3, 0.0)
+      , free(rest_positions.size() / 3, 1.0)
+      , external_force(rest_positions.size(), 0.0)
+      , rest(rest_positions)
+  {
+  }
+
+
+  ParticleSystem::~ParticleSystem() = default;
+
+
+  void
+  ParticleSystem::set_force_model(std::unique_ptr<ForceModel> model,
+                                  const unsigned int          n_threads)
+  {
+    forces = std::move(model);
+    forces->initialize(*this, n_threads);
+  }
+
+
+  void
+  ParticleSystem::compute_acceleration(const double *x, const double *v, double *a) const
+  {
+    const auto start = std::chrono::steady_clock::now();
+    forces->compute_acceleration(*this, x, v, a);
+    force_seconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+
+
+  double
+  ParticleSystem::kinetic_energy() const
+  {
+    double sum = 0;
+    for (unsigned int i = 0; i < n_particles(); ++i)
+      sum +=
+        mass[i]
+        * (velocity[3 * i] * velocity[3 * i] + velocity[3 * i + 1] * velocity[3 * i + 1]
+           + velocity[3 * i + 2] * velocity[3 * i + 2]);
+    return 0.5 * sum;
+  }
+
+
+  double
+  ParticleSystem::body_force_energy() const
+  {
+    double sum = 0;
+    for (unsigned int i = 0; i < n_particles(); ++i)
+      for (unsigned int d = 0; d < 3; ++d)
+        sum -= mass[i] * body_acceleration[d] * (position[3 * i + d] - rest[3 * i + d]);
+    return sum;
+  }
+
+
+  double
+  ParticleSystem::elastic_energy() const
+  {
+    return forces->elastic_energy(*this, position.data());
+  }
+} // namespace lacerta::physics

@@ -1,0 +1,229 @@
+#include <lacerta/base/exceptions.h>
+#include <lacerta/physics/force_model.h>
+#include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/stability.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace lacerta::physics
+{
+  namespace
+  {
+    /// Largest eigenvalue of a symmetric 3x3 matrix (trigonometric closed form).
+    double
+    largest_eigenvalue(const std::array<double, 6> &m) // xx, yy, zz, xy, xz, yz
+    {
+      const double p1 = m[3] * m[3] + m[4] * m[4] + m[5] * m[5];
+      const double q  = (m[0] + m[1] + m[2]) / 3.0;
+      if (p1 <= 1e-30 * (q * q + 1e-300))
+        return std::max({m[0], m[1], m[2]});
+      const double a = m[0] - q, b = m[1] - q, c = m[2] - q;
+      const double p = std::sqrt((a * a + b * b + c * c + 2 * p1) / 6.0);
+      // det((M - qI)/p) / 2
+      const double det = a * (b * c - m[5] * m[5]) - m[3] * (m[3] * c - m[5] * m[4])
+                         + m[4] * (m[3] * m[5] - b * m[4]);
+      const double r = std::clamp(det / (2 * p * p * p), -1.0, 1.0);
+      return q + 2 * p * std::cos(std::acos(r) / 3.0);
+    }
+
+
+    std::string
+    describe_particle(const ParticleSystem &system, const unsigned int i)
+    {
+      std::ostringstream s;
+      s.precision(6);
+      const auto &x = system.rest_position();
+      s << "particle " << i << " (rest position " << x[3 * i] << ", " << x[3 * i + 1]
+        << ", " << x[3 * i + 2] << ")";
+      return s.str();
+    }
+  } // namespace
+
+
+  FrequencyBound
+  bound_highest_frequency(const ParticleSystem &system)
+  {
+    const unsigned int                 n       = system.n_particles();
+    const SpringSet                   &springs = system.springs;
+    const double                      *x       = system.position.data();
+    std::vector<std::array<double, 6>> diagonal(n, std::array<double, 6>{});
+    std::vector<double>                off_diagonal(n, 0.0);
+    std::vector<double>                stiffest(n, 0.0);
+    std::vector<unsigned int>          stiffest_spring(n, 0);
+
+    for (std::size_t s = 0; s < springs.size(); ++s)
+    {
+      const unsigned int i = springs.a[s], j = springs.b[s];
+      double             d[3]   = {x[3 * j] - x[3 * i],
+                                   x[3 * j + 1] - x[3 * i + 1],
+                                   x[3 * j + 2] - x[3 * i + 2]};
+      const double       length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      for (double &c : d)
+        c /= length;
+      const double k         = springs.stiffness[s];
+      const double geometric = k * (1.0 - springs.rest_length[s] / length);
+      // K_e = (k - g) n nᵀ + g I, g the geometric stiffness.
+      const std::array<double, 6> block    = {(k - geometric) * d[0] * d[0] + geometric,
+                                              (k - geometric) * d[1] * d[1] + geometric,
+                                              (k - geometric) * d[2] * d[2] + geometric,
+                                              (k - geometric) * d[0] * d[1],
+                                              (k - geometric) * d[0] * d[2],
+                                              (k - geometric) * d[1] * d[2]};
+      const double                norm     = std::max(k, std::abs(geometric));
+      const double                coupling = (system.free[i] > 0 && system.free[j] > 0)
+                                               ? norm / std::sqrt(system.mass[i] * system.mass[j])
+                                               : 0.0;
+      for (const unsigned int p : {i, j})
+      {
+        for (unsigned int c = 0; c < 6; ++c)
+          diagonal[p][c] += block[c];
+        off_diagonal[p] += coupling;
+        if (norm > stiffest[p])
+        {
+          stiffest[p]        = norm;
+          stiffest_spring[p] = s;
+        }
+      }
+    }
+
+    FrequencyBound bound;
+    double         largest = 0;
+    for (unsigned int i = 0; i < n; ++i)
+      if (system.free[i] > 0 && system.mass[i] > 0)
+      {
+        std::array<double, 6> scaled = diagonal[i];
+        for (double &c : scaled)
+          c /= system.mass[i];
+        const double lambda = largest_eigenvalue(scaled) + off_diagonal[i];
+        if (lambda > largest)
+        {
+          largest        = lambda;
+          bound.particle = i;
+          bound.spring   = stiffest_spring[i];
+        }
+      }
+    bound.omega = std::sqrt(largest);
+    return bound;
+  }
+
+
+  std::string
+  describe_spring(const ParticleSystem &system, const unsigned int s)
+  {
+    const SpringSet   &springs = system.springs;
+    const double      *x       = system.position.data();
+    const unsigned int i = springs.a[s], j = springs.b[s];
+    std::ostringstream text;
+    text.precision(6);
+    text << "spring " << s << " between " << describe_particle(system, i) << " and "
+         << describe_particle(system, j) << ", stiffness " << springs.stiffness[s]
+         << " N/m, rest length " << springs.rest_length[s] << " m, length "
+         << std::hypot(x[3 * j] - x[3 * i],
+                       x[3 * j + 1] - x[3 * i + 1],
+                       x[3 * j + 2] - x[3 * i + 2])
+         << " m";
+    return text.str();
+  }
+
+
+  BlowUpMonitor::BlowUpMonitor(const ParticleSystem &system, const double tolerance)
+      : tolerance(tolerance)
+      , initial_energy(system.kinetic_energy() + system.elastic_energy()
+                       + system.body_force_energy())
+      , energy_scale(system.kinetic_energy() + system.elastic_energy())
+      , previous_position(system.position)
+      , previous_load(system.position.size(), 0.0)
+      , load(system.position.size(), 0.0)
+  {
+    // Energies far below a spring stretched to twice its length are noise.
+    double spring_energy = 0;
+    for (std::size_t s = 0; s < system.springs.size(); ++s)
+      spring_energy += system.springs.stiffness[s] * system.springs.rest_length[s]
+                       * system.springs.rest_length[s];
+    energy_floor = 1e-12 * spring_energy;
+    compute_load_forces(system);
+    previous_load = load;
+  }
+
+
+  void
+  BlowUpMonitor::compute_load_forces(const ParticleSystem &system)
+  {
+    // Prescribed particles push with the reaction to the spring forces on them;
+    // free particles receive the external forces.
+    system.force_model().compute_spring_forces(system,
+                                               system.position.data(),
+                                               system.velocity.data(),
+                                               load.data());
+    for (unsigned int i = 0; i < system.n_particles(); ++i)
+      for (unsigned int d = 0; d < 3; ++d)
+        load[3 * i + d] =
+          system.free[i] > 0 ? system.external_force[3 * i + d] : -load[3 * i + d];
+  }
+
+
+  void
+  BlowUpMonitor::check(const ParticleSystem &system,
+                       const unsigned int    step,
+                       const double          time)
+  {
+    for (unsigned int i = 0; i < system.n_particles(); ++i)
+      for (unsigned int d = 0; d < 3; ++d)
+        if (!std::isfinite(system.position[3 * i + d])
+            || !std::isfinite(system.velocity[3 * i + d]))
+          throw_error("The simulation blew up at step ",
+                      step,
+                      ", time ",
+                      time,
+                      " s: ",
+                      describe_particle(system, i),
+                      " has a position or velocity that is not a finite number. Reduce "
+                      "'Time step' or raise 'Stability/Safety factor' margin.");
+
+    compute_load_forces(system);
+    const std::vector<double> &x = system.position;
+    for (std::size_t c = 0; c < x.size(); ++c)
+      work += 0.5 * (previous_load[c] + load[c]) * (x[c] - previous_position[c]);
+    previous_position = x;
+    previous_load     = load;
+
+    const double kinetic = system.kinetic_energy();
+    const double elastic = system.elastic_energy();
+    const double body    = system.body_force_energy();
+    energy_scale =
+      std::max(energy_scale, kinetic + elastic + std::abs(body) + std::abs(work));
+    const double excess = kinetic + elastic + body - initial_energy - work;
+    if (excess > tolerance * energy_scale + energy_floor && excess > energy_floor)
+    {
+      unsigned int fastest = 0;
+      double       speed   = 0;
+      for (unsigned int i = 0; i < system.n_particles(); ++i)
+      {
+        const double *v = &system.velocity[3 * i];
+        const double  s = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        if (s > speed)
+        {
+          speed   = s;
+          fastest = i;
+        }
+      }
+      throw_error("The simulation blew up at step ",
+                  step,
+                  ", time ",
+                  time,
+                  " s: the mechanical energy (",
+                  kinetic + elastic + body,
+                  " J) exceeds the initial energy plus the work of the loads (",
+                  initial_energy + work,
+                  " J) by ",
+                  excess,
+                  " J, more than 'Energy growth tolerance' allows. The fastest is ",
+                  describe_particle(system, fastest),
+                  " at ",
+                  speed,
+                  " m/s. Reduce 'Time step' or add damping.");
+    }
+  }
+} // namespace lacerta::physics

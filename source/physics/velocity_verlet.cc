@@ -1,0 +1,81 @@
+// Integrator `velocity_verlet`: the second-order symplectic leapfrog.
+
+#include <lacerta/physics/integrator.h>
+#include <lacerta/physics/particle_system.h>
+
+#include <vector>
+
+namespace lacerta::physics
+{
+  namespace
+  {
+    /**
+     * Velocity Verlet: v½ = v + dt/2 a(x, v); x += dt v½; v = v½ + dt/2 a(x, v½).
+     * The acceleration at the end of a step is reused at the start of the next, so a
+     * step costs one evaluation; velocity-dependent forces (damping) are evaluated with
+     * the half-step velocity.
+     */
+    class VelocityVerlet : public Integrator
+    {
+    public:
+      static void
+      declare_parameters(dealii::ParameterHandler &)
+      {
+      }
+
+      void
+      initialize(const ParticleSystem &system) override
+      {
+        acceleration.assign(system.position.size(), 0.0);
+        acceleration_is_current = false;
+      }
+
+      void
+      step(ParticleSystem &system, const double t, const double dt) override
+      {
+        double *x = system.position.data();
+        double *v = system.velocity.data();
+        if (!acceleration_is_current)
+          system.compute_acceleration(x, v, acceleration.data());
+        for (std::size_t i = 0; i < acceleration.size(); ++i)
+        {
+          v[i] += 0.5 * dt * acceleration[i];
+          x[i] += dt * v[i];
+        }
+        // Constrained particles must be in place before the new forces are computed.
+        system.enforce_constraints(t + dt, x, v);
+        system.compute_acceleration(x, v, acceleration.data());
+        for (std::size_t i = 0; i < acceleration.size(); ++i)
+          v[i] += 0.5 * dt * acceleration[i];
+        system.enforce_constraints(t + dt, x, v);
+        acceleration_is_current = true;
+      }
+
+      double
+      critical_time_step(const double omega,
+                         const double mass_damping,
+                         const double spring_damping) const override
+      {
+        return symplectic_critical_time_step(
+          omega, modal_damping(omega, mass_damping, spring_damping));
+      }
+
+      unsigned int
+      n_evaluations_per_step() const override
+      {
+        return 1;
+      }
+
+    private:
+      std::vector<double> acceleration;
+      bool                acceleration_is_current = false;
+    };
+  } // namespace
+
+  LACERTA_REGISTER_INTEGRATOR(
+    VelocityVerlet,
+    "velocity_verlet",
+    "Velocity Verlet (leapfrog): one force evaluation per step, "
+    "second order, symplectic, stable up to ω·dt < 2 without "
+    "damping.");
+} // namespace lacerta::physics

@@ -1,0 +1,81 @@
+// Postprocessor `statistics`: one row per step in statistics.csv.
+
+#include <lacerta/base/exceptions.h>
+#include <lacerta/postprocess/postprocessor.h>
+
+#include <cstdio>
+#include <fstream>
+
+namespace lacerta::postprocess
+{
+  namespace
+  {
+    /**
+     * Writes statistics.csv: step, time, time step, sub-steps, energies, the work of
+     * the loads, and the wall time of the force evaluation and of the whole step.
+     */
+    class Statistics : public Postprocessor
+    {
+    public:
+      static void
+      declare_parameters(dealii::ParameterHandler &)
+      {
+      }
+
+      void
+      parse_parameters(dealii::ParameterHandler &) override
+      {
+      }
+
+      void
+      initialize(const std::string &output_directory, const bool test) override
+      {
+        file_name = output_directory + "/statistics.csv";
+        file.open(file_name);
+        if (!file)
+          throw_error("Cannot write '", file_name, "'.");
+        test_mode = test;
+        file << "step,time,time_step,substeps,kinetic_energy,elastic_energy,"
+                "body_force_energy,input_work,force_wall_s,step_wall_s\n";
+      }
+
+      bool
+      needs_energies(double) const override
+      {
+        return true;
+      }
+
+      void
+      execute(const RunState &s) override
+      {
+        char line[512];
+        std::snprintf(line,
+                      sizeof(line),
+                      "%u,%.9g,%.6g,%u,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g\n",
+                      s.step,
+                      s.time,
+                      s.time_step,
+                      s.substeps,
+                      s.kinetic_energy,
+                      s.elastic_energy,
+                      s.body_force_energy,
+                      s.input_work,
+                      test_mode ? 0.0 : s.force_seconds,
+                      test_mode ? 0.0 : s.step_seconds);
+        file << line;
+      }
+
+    private:
+      std::string   file_name;
+      std::ofstream file;
+      bool          test_mode = false;
+    };
+  } // namespace
+
+  LACERTA_REGISTER_POSTPROCESSOR(
+    Statistics,
+    "statistics",
+    "statistics.csv with one row per step: time, time step, "
+    "sub-steps, kinetic, elastic and body-force energy, work of "
+    "the loads, wall time of force evaluation and of the step.");
+} // namespace lacerta::postprocess

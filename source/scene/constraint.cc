@@ -1,0 +1,101 @@
+#include <lacerta/base/exceptions.h>
+#include <lacerta/physics/particle_system.h>
+#include <lacerta/scene/constraint.h>
+#include <lacerta/scene/region.h>
+
+#include <deal.II/base/utilities.h>
+
+namespace lacerta::scene
+{
+  void
+  Constraint::initialize(const std::vector<unsigned int> &selected,
+                         physics::ParticleSystem         &system)
+  {
+    particles = selected;
+    if (prescribes_motion())
+      for (const unsigned int i : particles)
+        system.free[i] = 0.0;
+  }
+
+
+  void
+  Constraint::prescribe(double, const double *, double *, double *) const
+  {
+  }
+
+
+  void
+  Constraint::add_forces(double, physics::ParticleSystem &) const
+  {
+  }
+
+
+  void
+  Constraint::declare_parameters(dealii::ParameterHandler       &prm,
+                                 const std::vector<std::string> &names)
+  {
+    prm.enter_subsection("Constraints");
+    prm.declare_entry("Names",
+                      "",
+                      dealii::Patterns::List(dealii::Patterns::Anything()),
+                      "Names of the constraints of the scene, separated by commas. Each "
+                      "name has a subsection of its own with 'Type', 'Region' and the "
+                      "subsections of the plugins ('lacerta --help' shows them under the "
+                      "placeholder name '<name>').");
+    for (const std::string &name : names)
+    {
+      prm.enter_subsection(name);
+      ConstraintRegistry::declare_selector(prm,
+                                           "Type",
+                                           "fixed",
+                                           "What the constraint does.");
+      RegionRegistry::declare_selector(prm,
+                                       "Region",
+                                       "box",
+                                       "Which particles the constraint acts on, selected "
+                                       "in the rest configuration.");
+      ConstraintRegistry::declare_all_in_subsections(prm);
+      RegionRegistry::declare_all_in_subsections(prm);
+      prm.leave_subsection();
+    }
+    prm.leave_subsection();
+  }
+
+
+  std::vector<std::string>
+  Constraint::names(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection("Constraints");
+    const std::vector<std::string> list =
+      dealii::Utilities::split_string_list(prm.get("Names"));
+    prm.leave_subsection();
+    return list;
+  }
+
+
+  std::vector<std::unique_ptr<Constraint>>
+  Constraint::create(dealii::ParameterHandler &prm, const mesh::TetMesh &mesh)
+  {
+    std::vector<std::unique_ptr<Constraint>> constraints;
+    const std::vector<std::string>           list = names(prm);
+    prm.enter_subsection("Constraints");
+    for (const std::string &name : list)
+    {
+      prm.enter_subsection(name);
+      auto constraint       = ConstraintRegistry::create_and_parse(prm.get("Type"), prm);
+      auto region           = RegionRegistry::create_and_parse(prm.get("Region"), prm);
+      constraint->name      = name;
+      constraint->particles = region->select(mesh);
+      if (constraint->particles.empty())
+        throw_error("Constraints/",
+                    name,
+                    ": the region ('",
+                    prm.get("Region"),
+                    "') contains no particle of the mesh.");
+      prm.leave_subsection();
+      constraints.push_back(std::move(constraint));
+    }
+    prm.leave_subsection();
+    return constraints;
+  }
+} // namespace lacerta::scene

@@ -1,0 +1,96 @@
+#include <lacerta/base/exceptions.h>
+#include <lacerta/scene/material.h>
+
+namespace lacerta::scene
+{
+  namespace
+  {
+    std::unique_ptr<dealii::FunctionParser<3>>
+    parse_field(const std::string &entry,
+                const std::string &expression,
+                const std::string &constants)
+    {
+      std::map<std::string, double> values;
+      for (const auto &pair : dealii::Utilities::split_string_list(constants, ','))
+      {
+        const auto parts = dealii::Utilities::split_string_list(pair, '=');
+        if (parts.size() != 2)
+          throw_error("Material/Function constants: '",
+                      pair,
+                      "' is not of the form name=value.");
+        values[parts[0]] = dealii::Utilities::string_to_double(parts[1]);
+      }
+      auto function = std::make_unique<dealii::FunctionParser<3>>(1);
+      try
+      {
+        function->initialize("x,y,z", expression, values);
+        function->value(dealii::Point<3>());
+      }
+      catch (const dealii::ExceptionBase &e)
+      {
+        std::ostringstream info;
+        e.print_info(info);
+        throw_error("Material/",
+                    entry,
+                    ": cannot evaluate the expression '",
+                    expression,
+                    "': ",
+                    info.str());
+      }
+      return function;
+    }
+  } // namespace
+
+
+  void
+  Material::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection("Material");
+    prm.declare_entry("Density",
+                      "1000",
+                      dealii::Patterns::Anything(),
+                      "Mass density σ(x, y, z) [kg/m^3], an expression in deal.II's "
+                      "FunctionParser syntax. Particle masses integrate it exactly for "
+                      "polynomials up to degree 2 (Section 3.1).");
+    prm.declare_entry("Youngs modulus",
+                      "1e6",
+                      dealii::Patterns::Anything(),
+                      "Young's modulus E(x, y, z) [Pa], an expression; evaluated at the "
+                      "centroid of every tetrahedron for the spring stiffness "
+                      "k_e = sum E V / |e|^2 (Section 3.2).");
+    prm.declare_entry("Poisson ratio",
+                      "0.25",
+                      dealii::Patterns::Double(0.0, 0.499),
+                      "Poisson ratio of the FEM reference. A spring lattice behaves like "
+                      "ν = 1/4 whatever is asked here.");
+    prm.declare_entry(
+      "Function constants",
+      "",
+      dealii::Patterns::Anything(),
+      "Constants usable in the expressions, as 'name=value, name=value'.");
+    prm.declare_entry("Mass damping",
+                      "0",
+                      dealii::Patterns::Double(0.0, 1e6),
+                      "Viscous damping per particle c [1/s]: force -c m v.");
+    prm.declare_entry("Spring damping",
+                      "0",
+                      dealii::Patterns::Double(0.0, 1.0),
+                      "Damping along springs β [s]: force -β k ((v_b - v_a)·n) n, i.e. "
+                      "stiffness-proportional (Rayleigh) damping.");
+    prm.leave_subsection();
+  }
+
+
+  void
+  Material::parse_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection("Material");
+    const std::string constants = prm.get("Function constants");
+    density_function            = parse_field("Density", prm.get("Density"), constants);
+    youngs_function = parse_field("Youngs modulus", prm.get("Youngs modulus"), constants);
+    poisson_ratio   = prm.get_double("Poisson ratio");
+    mass_damping    = prm.get_double("Mass damping");
+    spring_damping  = prm.get_double("Spring damping");
+    prm.leave_subsection();
+  }
+} // namespace lacerta::scene

@@ -1,0 +1,357 @@
+#include <lacerta/base/exceptions.h>
+#include <lacerta/base/input_path.h>
+#include <lacerta/physics/integrator.h>
+#include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/stability.h>
+#include <lacerta/postprocess/postprocessor.h>
+#include <lacerta/scene/scene.h>
+#include <lacerta/simulator/simulator.h>
+
+#include <deal.II/base/timer.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <unistd.h>
+
+namespace lacerta
+{
+  namespace
+  {
+    using Clock = std::chrono::steady_clock;
+
+    double
+    seconds_since(const Clock::time_point start)
+    {
+      return std::chrono::duration<double>(Clock::now() - start).count();
+    }
+
+
+    /// Largest displacement from the rest position and the particle that has it.
+    std::pair<double, unsigned int>
+    largest_displacement(const physics::ParticleSystem &system)
+    {
+      double       largest = 0;
+      unsigned int where   = 0;
+      for (unsigned int i = 0; i < system.n_particles(); ++i)
+      {
+        const double *x = &system.position[3 * i];
+        const double *r = &system.rest_position()[3 * i];
+        const double  d = std::hypot(x[0] - r[0], x[1] - r[1], x[2] - r[2]);
+        if (d > largest)
+        {
+          largest = d;
+          where   = i;
+        }
+      }
+      return {largest, where};
+    }
+  } // namespace
+
+
+  void
+  Simulator::declare_parameters(dealii::ParameterHandler       &prm,
+                                const std::vector<std::string> &constraint_names)
+  {
+    prm.declare_entry(
+      "Output directory",
+      "output",
+      dealii::Patterns::DirectoryName(),
+      "Where the run writes its files (created if needed); the parameters "
+      "it used are copied there as parameters.prm.");
+    prm.declare_entry("End time",
+                      "1",
+                      dealii::Patterns::Double(0.0),
+                      "Simulated time at which the run stops [s].");
+    prm.declare_entry(
+      "Time step",
+      "1e-4",
+      dealii::Patterns::Double(1e-12, 10.0),
+      "Time step [s]. If it is above the stability limit the run sub-steps "
+      "or stops (see 'Stability/Time step above limit').");
+    prm.declare_entry("Number of threads",
+                      "1",
+                      dealii::Patterns::Integer(1, 256),
+                      "Threads for the force evaluation.");
+    prm.declare_entry(
+      "Test mode",
+      "false",
+      dealii::Patterns::Bool(),
+      "Print no timings and no progress line and write zero wall times, so "
+      "that the output of two runs can be compared.");
+
+    prm.enter_subsection("Stability");
+    prm.declare_entry(
+      "Time step above limit",
+      "substep",
+      dealii::Patterns::Selection("substep|stop"),
+      "What to do if 'Time step' exceeds the critical time step of the "
+      "integrator: 'substep' splits every step into enough equal sub-steps, "
+      "'stop' ends the run with a message naming the limit and the spring "
+      "that sets it.");
+    prm.declare_entry("Safety factor",
+                      "0.9",
+                      dealii::Patterns::Double(0.01, 1.0),
+                      "Fraction of the critical time step that a (sub-)step may use.");
+    prm.declare_entry("Energy growth tolerance",
+                      "1",
+                      dealii::Patterns::Double(1e-6, 1e6),
+                      "The run stops as blown up when the mechanical energy exceeds the "
+                      "initial energy plus the work of the loads by this fraction of the "
+                      "largest energy seen.");
+    prm.declare_entry(
+      "Check interval",
+      "10",
+      dealii::Patterns::Integer(1, 1000000),
+      "Steps between two blow-up checks (non-finite state, energy growth); "
+      "the state is also checked before every output.");
+    prm.leave_subsection();
+
+    scene::Scene::declare_parameters(prm, constraint_names);
+    physics::Integrator::declare_parameters(prm);
+    postprocess::Postprocessor::declare_parameters(prm);
+  }
+
+
+  void
+  Simulator::read_parameters(const std::string &file, dealii::ParameterHandler &prm)
+  {
+    if (!std::ifstream(file))
+      throw_error("Parameter file '", file, "' cannot be opened.");
+    set_input_directory(std::filesystem::path(file).parent_path().string());
+
+    const auto parse = [&](dealii::ParameterHandler &handler, const bool skip_undefined)
+    {
+      try
+      {
+        handler.parse_input(file, "", skip_undefined);
+      }
+      catch (const dealii::ExceptionBase &e)
+      {
+        std::ostringstream info;
+        e.print_info(info);
+        throw_error("Parameter file '", file, "': ", info.str());
+      }
+    };
+
+    // First pass: learn the constraint names, which declare subsections of their own.
+    dealii::ParameterHandler first;
+    declare_parameters(first, {});
+    parse(first, true);
+    declare_parameters(prm, scene::Constraint::names(first));
+    parse(prm, false);
+  }
+
+
+  void
+  Simulator::print_help(std::ostream &out)
+  {
+    dealii::ParameterHandler prm;
+    declare_parameters(prm, {"<name>"});
+    out << "Usage: lacerta <scene.prm>\n       lacerta --help\n\n"
+        << "The default parameter file, with every entry documented. Each plugin kind "
+           "lists its plugins in the documentation of its selector entry. The "
+           "constraints are named instances (Constraints/Names); '<name>' stands for "
+           "one of them.\n\n";
+    prm.print_parameters(out, dealii::ParameterHandler::PRM);
+  }
+
+
+  Simulator::Simulator(dealii::ParameterHandler &prm, const std::string &parameter_file)
+  {
+    output_directory = prm.get("Output directory");
+    end_time         = prm.get_double("End time");
+    time_step        = prm.get_double("Time step");
+    n_threads        = prm.get_integer("Number of threads");
+    test_mode        = prm.get_bool("Test mode");
+    prm.enter_subsection("Stability");
+    substep_when_unstable = prm.get("Time step above limit") == "substep";
+    safety_factor         = prm.get_double("Safety factor");
+    energy_tolerance      = prm.get_double("Energy growth tolerance");
+    check_interval        = prm.get_integer("Check interval");
+    prm.leave_subsection();
+
+    std::error_code error;
+    std::filesystem::create_directories(output_directory, error);
+    std::ofstream copy(output_directory + "/parameters.prm");
+    if (error || !copy)
+      throw_error("Cannot create the output directory '", output_directory, "'.");
+    copy << "# Parameters used by lacerta for " << parameter_file << "\n";
+    prm.print_parameters(copy, dealii::ParameterHandler::ShortPRM);
+
+    scene          = std::make_unique<scene::Scene>(prm, n_threads);
+    integrator     = physics::Integrator::create(prm);
+    postprocessors = postprocess::Postprocessor::create(prm);
+    integrator->initialize(*scene->system);
+    for (auto &p : postprocessors)
+      p->initialize(output_directory, test_mode);
+  }
+
+
+  Simulator::~Simulator() = default;
+
+
+  unsigned int
+  Simulator::choose_substeps()
+  {
+    const physics::ParticleSystem &system = *scene->system;
+    const physics::FrequencyBound  bound  = physics::bound_highest_frequency(system);
+    if (bound.omega == 0)
+      return 1;
+    const double critical = integrator->critical_time_step(bound.omega,
+                                                           system.mass_damping,
+                                                           system.spring_damping);
+    std::cout << "Stability: highest eigenfrequency <= " << bound.omega
+              << " rad/s (Gershgorin bound at particle " << bound.particle
+              << "); critical time step " << critical << " s; time step " << time_step
+              << " s\n";
+    if (critical <= 0)
+      throw_error(
+        "No time step is stable for this integrator on this system: it amplifies "
+        "every undamped oscillation. Set 'Material/Mass damping' or "
+        "'Material/Spring damping' above 0, or choose another 'Integrator/Scheme'.");
+    const double allowed = safety_factor * critical;
+    if (time_step <= allowed)
+      return 1;
+    if (!substep_when_unstable)
+      throw_error(
+        "'Time step' = ",
+        time_step,
+        " s is above the stability limit ",
+        critical,
+        " s of the integrator (times 'Stability/Safety factor' = ",
+        safety_factor,
+        ": ",
+        allowed,
+        " s). The limit is set by ",
+        physics::describe_spring(system, bound.spring),
+        ". Reduce 'Time step' or set 'Stability/Time step above limit' = substep.");
+    const unsigned int n = static_cast<unsigned int>(std::ceil(time_step / allowed));
+    std::cout << "Stability: each step is split into " << n << " sub-steps of "
+              << time_step / n << " s\n";
+    return n;
+  }
+
+
+  void
+  Simulator::run()
+  {
+    dealii::TimerOutput      timer(std::cout,
+                              dealii::TimerOutput::never,
+                              dealii::TimerOutput::wall_times);
+    physics::ParticleSystem &system = *scene->system;
+    scene->print_summary(std::cout);
+    std::cout << "Integrator: "
+              << "time step " << time_step << " s, end time " << end_time << " s\n";
+    const unsigned int substeps = choose_substeps();
+
+    physics::BlowUpMonitor monitor(system, energy_tolerance);
+    postprocess::RunState  state;
+    state.mesh     = &scene->mesh;
+    state.system   = &system;
+    state.material = &scene->material;
+    state.substeps = substeps;
+
+    const auto evaluate_energies = [&]
+    {
+      state.kinetic_energy    = system.kinetic_energy();
+      state.elastic_energy    = system.elastic_energy();
+      state.body_force_energy = system.body_force_energy();
+      state.input_work        = monitor.input_work();
+    };
+    const auto postprocess = [&](const unsigned int step)
+    {
+      bool writes = false, needs_energies = false;
+      for (const auto &p : postprocessors)
+      {
+        writes |= p->writes_state(state.time);
+        needs_energies |= p->needs_energies(state.time);
+      }
+      if (writes || step % check_interval == 0)
+        monitor.check(system, step, state.time);
+      if (needs_energies)
+      {
+        evaluate_energies();
+        if (!std::isfinite(state.kinetic_energy + state.elastic_energy))
+          monitor.check(system, step, state.time);
+      }
+      dealii::TimerOutput::Scope scope(timer, "output");
+      for (auto &p : postprocessors)
+        p->execute(state);
+    };
+
+    postprocess(0);
+    const double       epsilon = 1e-9 * time_step;
+    const unsigned int n_steps =
+      static_cast<unsigned int>(std::ceil((end_time - epsilon) / time_step));
+    const unsigned int n_reports     = 10;
+    const bool         show_progress = !test_mode && isatty(STDERR_FILENO);
+    const auto         run_start     = Clock::now();
+    double             last_progress = 0;
+    std::cout << "Running " << n_steps << " steps\n";
+
+    double time = 0;
+    for (unsigned int step = 1; step <= n_steps; ++step)
+    {
+      const double dt         = std::min(time_step, end_time - time);
+      const double h          = dt / substeps;
+      const auto   step_start = Clock::now();
+      {
+        dealii::TimerOutput::Scope scope(timer, "integration");
+        system.force_seconds = 0;
+        for (unsigned int k = 0; k < substeps; ++k)
+        {
+          scene->update_loads(time + k * h);
+          integrator->step(system, time + k * h, h);
+        }
+      }
+      time                = (step == n_steps) ? end_time : time + dt;
+      state.step          = step;
+      state.time          = time;
+      state.time_step     = dt;
+      state.step_seconds  = seconds_since(step_start);
+      state.force_seconds = system.force_seconds;
+      postprocess(step);
+
+      if (step * n_reports / n_steps != (step - 1) * n_reports / n_steps
+          || step == n_steps)
+      {
+        monitor.check(system, step, time);
+        evaluate_energies();
+        const auto [displacement, where] = largest_displacement(system);
+        std::cout << "t = " << time << " s: kinetic energy " << state.kinetic_energy
+                  << " J, elastic energy " << state.elastic_energy
+                  << " J, largest displacement " << displacement << " m (particle "
+                  << where << ")\n";
+      }
+      const double elapsed = seconds_since(run_start);
+      if (show_progress && elapsed > 2 && elapsed - last_progress > 1)
+      {
+        last_progress = elapsed;
+        std::fprintf(stderr,
+                     "\rstep %u/%u  t = %.4g s  %3.0f%%  %.0f s left   ",
+                     step,
+                     n_steps,
+                     time,
+                     100.0 * step / n_steps,
+                     elapsed * (n_steps - step) / step);
+      }
+    }
+    if (show_progress && last_progress > 0)
+      std::fprintf(stderr, "\n");
+
+    std::cout << "Done: " << n_steps << " steps, " << n_steps * substeps
+              << " integrator steps\n";
+    if (!test_mode)
+    {
+      const double wall = seconds_since(run_start);
+      std::cout << "Wall time " << wall << " s; force evaluation throughput "
+                << double(system.springs.size()) * integrator->n_evaluations_per_step()
+                     * n_steps * substeps / wall
+                << " springs/s (whole loop)\n";
+      timer.print_summary();
+    }
+  }
+} // namespace lacerta
