@@ -1,0 +1,706 @@
+/**
+ * @file
+ * Test support for the split table: tetrahedron shapes, a minimal mesh cutter on raw
+ * arrays (global snapping, front points per face, point keys, vertex copies by
+ * connected components), and geometric checks of splits and meshes. It mirrors what
+ * the real cutter has to do, so that the tests exercise the table the way it will be
+ * used.
+ */
+#pragma once
+
+#include <lacerta/cut/split_table.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <numeric>
+#include <random>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace lacerta::cut::test_support
+{
+  inline Point
+  sub(const Point &a, const Point &b)
+  {
+    return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+  }
+
+  inline Point
+  add(const Point &a, const Point &b)
+  {
+    return {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
+  }
+
+  inline Point
+  scale(const double s, const Point &a)
+  {
+    return {s * a[0], s * a[1], s * a[2]};
+  }
+
+  inline Point
+  lerp(const Point &a, const Point &b, const double t)
+  {
+    return add(a, scale(t, sub(b, a)));
+  }
+
+  inline double
+  dot(const Point &a, const Point &b)
+  {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  }
+
+  inline Point
+  cross(const Point &a, const Point &b)
+  {
+    return {a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0]};
+  }
+
+  inline double
+  norm(const Point &a)
+  {
+    return std::sqrt(dot(a, a));
+  }
+
+  inline Point
+  normalized(const Point &a)
+  {
+    return scale(1.0 / norm(a), a);
+  }
+
+  inline double
+  volume(const Point &a, const Point &b, const Point &c, const Point &d)
+  {
+    return signed_volume6(a, b, c, d) / 6.0;
+  }
+
+  inline double
+  triangle_area(const Point &a, const Point &b, const Point &c)
+  {
+    return 0.5 * norm(cross(sub(b, a), sub(c, a)));
+  }
+
+  /**
+   * Area of a planar convex polygon given by its corners in any order.
+   */
+  inline double
+  convex_polygon_area(std::vector<Point> corners, const Point &normal)
+  {
+    if (corners.size() < 3)
+      return 0;
+    Point c{0, 0, 0};
+    for (const auto &p : corners)
+      c = add(c, scale(1.0 / corners.size(), p));
+    const Point u = sub(corners[0], c);
+    const Point w = cross(normal, u);
+    std::sort(corners.begin(),
+              corners.end(),
+              [&](const Point &a, const Point &b)
+              {
+                return std::atan2(dot(w, sub(a, c)), dot(u, sub(a, c)))
+                       < std::atan2(dot(w, sub(b, c)), dot(u, sub(b, c)));
+              });
+    double area = 0;
+    for (std::size_t k = 1; k + 1 < corners.size(); ++k)
+      area += triangle_area(corners[0], corners[k], corners[k + 1]);
+    return area;
+  }
+
+  /**
+   * Tetrahedron shapes, positively oriented: well-shaped random ones and the four
+   * classical degenerate kinds.
+   */
+  enum class Shape
+  {
+    random,
+    needle, // three vertices close together, the fourth far: one long thin spike
+    sliver, // four vertices near a square, almost coplanar, no short edge
+    cap,    // one vertex just above the centre of the opposite face
+    wedge   // one short edge, the other two vertices far apart
+  };
+
+  inline const char *
+  shape_name(const Shape s)
+  {
+    switch (s)
+    {
+      case Shape::random:
+        return "random";
+      case Shape::needle:
+        return "needle";
+      case Shape::sliver:
+        return "sliver";
+      case Shape::cap:
+        return "cap";
+      case Shape::wedge:
+        return "wedge";
+    }
+    return "?";
+  }
+
+  inline std::array<Point, 4>
+  make_tetrahedron(const Shape shape, std::mt19937 &rng)
+  {
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::array<Point, 4>                   x;
+    switch (shape)
+    {
+      case Shape::random:
+        do
+          for (auto &p : x)
+            p = {u(rng), u(rng), u(rng)};
+        while (std::abs(volume(x[0], x[1], x[2], x[3])) < 0.05);
+        break;
+      case Shape::needle:
+        x = {{{0, 0, 0}, {1e-2, 0, 0}, {0, 1e-2, 0}, {0.003, 0.003, 1.0}}};
+        break;
+      case Shape::sliver:
+        x = {{{0, 0, 0}, {1, 1, 0}, {1, 0, 1e-3}, {0, 1, 1e-3}}};
+        break;
+      case Shape::cap:
+        x = {{{0, 0, 0}, {1, 0, 0}, {0.5, 0.9, 0}, {0.5, 0.3, 1e-3}}};
+        break;
+      case Shape::wedge:
+        x = {{{0, 0, 0}, {1e-2, 0, 0}, {0.5, 1, 0}, {0.5, 0, 1}}};
+        break;
+    }
+    // A random rigid motion and scale, so that nothing is axis-aligned.
+    if (shape != Shape::random)
+    {
+      const Point  axis  = normalized({u(rng), u(rng), u(rng)});
+      const double angle = 3.0 * u(rng);
+      const double s     = 0.5 + 0.5 * (u(rng) + 1);
+      const Point  shift{u(rng), u(rng), u(rng)};
+      for (auto &p : x)
+      {
+        const Point r =
+          add(add(scale(std::cos(angle), p), scale(std::sin(angle), cross(axis, p))),
+              scale((1 - std::cos(angle)) * dot(axis, p), axis));
+        p = add(scale(s, r), shift);
+      }
+    }
+    if (volume(x[0], x[1], x[2], x[3]) < 0)
+      std::swap(x[0], x[1]);
+    return x;
+  }
+
+  /**
+   * A plane: points x with dot(normal, x - origin) = 0.
+   */
+  struct Plane
+  {
+    Point origin{};
+    Point normal{};
+
+    double
+    operator()(const Point &x) const
+    {
+      return dot(normal, sub(x, origin));
+    }
+  };
+
+  /**
+   * A planar cut surface, possibly bounded by a straight crack front: the crack is the
+   * part of the plane where front(x) < 0.
+   */
+  struct CutSurface
+  {
+    Plane plane;
+    bool  has_front = false;
+    Plane front;
+
+    double
+    behind(const Point &x) const
+    {
+      return has_front ? front(x) : -1.0;
+    }
+  };
+
+  /**
+   * A tetrahedral mesh on raw arrays; vertex ids are indices into points.
+   */
+  struct Mesh
+  {
+    std::vector<Point>                        points;
+    std::vector<std::array<std::uint32_t, 4>> tets;
+  };
+
+  inline std::array<std::uint32_t, 3>
+  sorted(std::uint32_t a, std::uint32_t b, std::uint32_t c)
+  {
+    std::array<std::uint32_t, 3> f{a, b, c};
+    std::sort(f.begin(), f.end());
+    return f;
+  }
+
+  /**
+   * What the cutter decides globally before splitting: sides after snapping, cut edges
+   * with their parameters, and front points per face; then one TetCut per affected
+   * tetrahedron.
+   */
+  struct CutAnalysis
+  {
+    std::vector<std::int8_t>                                  side;
+    std::map<std::pair<std::uint32_t, std::uint32_t>, double> edge_t;
+    std::map<std::array<std::uint32_t, 3>, Point>             front_points;
+    std::vector<std::size_t>                                  affected;
+    std::vector<TetCut>                                       cuts;
+  };
+
+  inline CutAnalysis
+  analyse(const Mesh &mesh, const CutSurface &surface, const double eps)
+  {
+    CutAnalysis       a;
+    const auto       &x    = mesh.points;
+    const std::size_t n    = x.size();
+    double            size = 0;
+    for (const auto &p : x)
+      size = std::max({size, std::abs(p[0]), std::abs(p[1]), std::abs(p[2])});
+    const double zero = 1e-12 * std::max(size, 1.0);
+
+    std::vector<double> d(n);
+    for (std::size_t v = 0; v < n; ++v)
+    {
+      d[v] = surface.plane(x[v]);
+      if (std::abs(d[v]) <= zero)
+        d[v] = 0;
+    }
+    std::set<std::pair<std::uint32_t, std::uint32_t>> edges;
+    for (const auto &t : mesh.tets)
+      for (const auto &e : tet_edge_vertices)
+        edges.insert({std::min(t[e[0]], t[e[1]]), std::max(t[e[0]], t[e[1]])});
+
+    // Snapping, once per mesh edge: a reached crossing close to an end moves there.
+    std::vector<bool> on_cut(n, false);
+    for (std::size_t v = 0; v < n; ++v)
+      on_cut[v] = d[v] == 0 && surface.behind(x[v]) < 0;
+    for (const auto &[i, j] : edges)
+      if (d[i] * d[j] < 0)
+      {
+        const double t = d[i] / (d[i] - d[j]);
+        if (surface.behind(lerp(x[i], x[j], t)) >= 0)
+          continue;
+        const EdgeSnap s = snap_edge_parameter(t, eps);
+        if (s == EdgeSnap::first_vertex)
+          on_cut[i] = true;
+        else if (s == EdgeSnap::second_vertex)
+          on_cut[j] = true;
+      }
+    a.side.resize(n);
+    for (std::size_t v = 0; v < n; ++v)
+      a.side[v] =
+        on_cut[v] ? 0 : (d[v] >= 0 ? 1 : -1); // unreached points on the plane: +
+
+    // Cut edges: opposite sides and reached.
+    std::map<std::pair<std::uint32_t, std::uint32_t>, bool> crossing_reached;
+    for (const auto &[i, j] : edges)
+      if (a.side[i] * a.side[j] < 0)
+      {
+        const double t           = d[i] / (d[i] - d[j]);
+        const bool   reached     = surface.behind(lerp(x[i], x[j], t)) < 0;
+        crossing_reached[{i, j}] = reached;
+        if (reached)
+          a.edge_t[{i, j}] = t;
+      }
+
+    // Front points, once per face, from the face's own two section corners.
+    std::set<std::array<std::uint32_t, 3>> faces;
+    for (const auto &t : mesh.tets)
+      for (unsigned f = 0; f < 4; ++f)
+        faces.insert(sorted(t[(f + 1) % 4], t[(f + 2) % 4], t[(f + 3) % 4]));
+    if (surface.has_front)
+      for (const auto &f : faces)
+      {
+        std::vector<std::pair<Point, bool>> corners; // position, reached
+        for (unsigned k = 0; k < 3; ++k)
+          if (a.side[f[k]] == 0)
+            corners.push_back({x[f[k]], true});
+        for (unsigned k = 0; k < 3; ++k)
+          for (unsigned l = k + 1; l < 3; ++l)
+          {
+            const auto it = crossing_reached.find({f[k], f[l]});
+            if (it == crossing_reached.end())
+              continue;
+            const double t = d[f[k]] / (d[f[k]] - d[f[l]]);
+            corners.push_back({lerp(x[f[k]], x[f[l]], t), it->second});
+          }
+        if (corners.size() != 2 || corners[0].second == corners[1].second)
+          continue;
+        const auto  &r  = corners[0].second ? corners[0] : corners[1];
+        const auto  &u  = corners[0].second ? corners[1] : corners[0];
+        const double pr = surface.behind(r.first), pu = surface.behind(u.first);
+        const double s    = clamp_front_parameter(pr / (pr - pu), eps);
+        a.front_points[f] = lerp(r.first, u.first, s);
+      }
+
+    for (std::size_t k = 0; k < mesh.tets.size(); ++k)
+    {
+      const auto &t = mesh.tets[k];
+      TetCut      c;
+      bool        affected = false;
+      for (unsigned v = 0; v < 4; ++v)
+      {
+        c.vertex_ids[v]  = t[v];
+        c.points[v]      = x[t[v]];
+        c.vertex_side[v] = a.side[t[v]];
+        affected |= a.side[t[v]] == 0;
+      }
+      for (unsigned e = 0; e < 6; ++e)
+      {
+        const std::uint32_t i = t[tet_edge_vertices[e][0]],
+                            j = t[tet_edge_vertices[e][1]];
+        const auto it         = a.edge_t.find({std::min(i, j), std::max(i, j)});
+        if (it != a.edge_t.end())
+        {
+          c.cut_edges |= static_cast<std::uint8_t>(1u << e);
+          c.edge_parameter[e] = it->second;
+          affected            = true;
+        }
+      }
+      for (unsigned f = 0; f < 4; ++f)
+      {
+        const auto it =
+          a.front_points.find(sorted(t[(f + 1) % 4], t[(f + 2) % 4], t[(f + 3) % 4]));
+        if (it != a.front_points.end())
+        {
+          c.front_faces |= static_cast<std::uint8_t>(1u << f);
+          c.front_points[f] = it->second;
+          affected          = true;
+        }
+      }
+      if (affected)
+      {
+        a.affected.push_back(k);
+        a.cuts.push_back(c);
+      }
+    }
+    return a;
+  }
+
+  /**
+   * Positions of the nodes of a child.
+   */
+  inline std::array<Point, 4>
+  child_points(const TetCut &cut, const SplitResult &r, const Child &c)
+  {
+    std::array<Point, 4> p;
+    for (unsigned k = 0; k < 4; ++k)
+    {
+      const NodeRef &n = c.nodes[k];
+      switch (n.kind)
+      {
+        case NodeKind::vertex:
+          p[k] = cut.points[n.index];
+          break;
+        case NodeKind::edge_point:
+          p[k] = r.edge_points[n.index];
+          break;
+        case NodeKind::face_point:
+          p[k] = r.face_points[n.index];
+          break;
+        case NodeKind::interior_point:
+          p[k] = r.interior_point;
+          break;
+      }
+    }
+    return p;
+  }
+
+  struct CutStatistics
+  {
+    std::size_t split_tets  = 0;
+    std::size_t children    = 0;
+    std::size_t unsupported = 0;
+  };
+
+  /**
+   * Applies one cut to the whole mesh: splits every affected tetrahedron, merges the new
+   * points by key, and gives a vertex on the cut one copy per group of its tetrahedra
+   * that stay connected through faces not on the cut.
+   */
+  inline CutStatistics
+  cut_mesh(Mesh &mesh, const CutSurface &surface, const double eps)
+  {
+    CutStatistics                             stats;
+    const CutAnalysis                         a = analyse(mesh, surface, eps);
+    std::map<PointKey, std::uint32_t>         ids;
+    std::vector<std::array<std::uint32_t, 4>> tets;
+    std::vector<bool>                         replaced(mesh.tets.size(), false);
+    std::set<std::array<std::uint32_t, 3>>    cut_faces;
+    std::vector<Point>                       &points = mesh.points;
+
+    SplitResult r;
+    for (std::size_t k = 0; k < a.cuts.size(); ++k)
+    {
+      const TetCut &c = a.cuts[k];
+      if (split_tetrahedron(c, r, eps) == CutKind::unsupported)
+      {
+        ++stats.unsupported;
+        continue;
+      }
+      replaced[a.affected[k]] = true;
+      ++stats.split_tets;
+      stats.children += r.n_children;
+      for (unsigned i = 0; i < r.n_children; ++i)
+      {
+        const Child                 &child = r.children[i];
+        const auto                   p     = child_points(c, r, child);
+        std::array<std::uint32_t, 4> t;
+        for (unsigned j = 0; j < 4; ++j)
+        {
+          const NodeRef &n = child.nodes[j];
+          if (n.kind == NodeKind::vertex)
+          {
+            t[j] = static_cast<std::uint32_t>(c.vertex_ids[n.index]);
+            continue;
+          }
+          const PointKey key = point_key(c.vertex_ids, n, a.affected[k]);
+          const auto     it  = ids.find(key);
+          if (it != ids.end())
+            t[j] = it->second;
+          else
+          {
+            t[j] = static_cast<std::uint32_t>(points.size());
+            points.push_back(p[j]);
+            ids.emplace(key, t[j]);
+          }
+        }
+        for (unsigned j = 0; j < 4; ++j)
+          if (child.cut_faces & (1u << j))
+            cut_faces.insert(sorted(t[(j + 1) % 4], t[(j + 2) % 4], t[(j + 3) % 4]));
+        tets.push_back(t);
+      }
+    }
+    for (std::size_t k = 0; k < mesh.tets.size(); ++k)
+      if (!replaced[k])
+        tets.push_back(mesh.tets[k]);
+
+    // Copies of vertices on the cut: one per connected group of incident tetrahedra.
+    std::map<std::uint32_t, std::vector<std::size_t>> incident;
+    for (std::size_t k = 0; k < tets.size(); ++k)
+      for (const auto v : tets[k])
+        if (v < a.side.size() && a.side[v] == 0)
+          incident[v].push_back(k);
+    for (const auto &[v, list] : incident)
+    {
+      std::vector<std::size_t> parent(list.size());
+      std::iota(parent.begin(), parent.end(), 0);
+      const auto find = [&](std::size_t i)
+      {
+        while (parent[i] != i)
+          i = parent[i] = parent[parent[i]];
+        return i;
+      };
+      std::map<std::array<std::uint32_t, 3>, std::size_t> first_with_face;
+      for (std::size_t i = 0; i < list.size(); ++i)
+      {
+        const auto &t = tets[list[i]];
+        for (unsigned f = 0; f < 4; ++f)
+        {
+          const auto face = sorted(t[(f + 1) % 4], t[(f + 2) % 4], t[(f + 3) % 4]);
+          if (std::find(face.begin(), face.end(), v) == face.end()
+              || cut_faces.count(face))
+            continue;
+          const auto [it, inserted] = first_with_face.emplace(face, i);
+          if (!inserted)
+            parent[find(i)] = find(it->second);
+        }
+      }
+      std::map<std::size_t, std::uint32_t> copy_of_root;
+      for (std::size_t i = 0; i < list.size(); ++i)
+      {
+        const std::size_t root = find(i);
+        if (copy_of_root.empty())
+          copy_of_root[root] = v;
+        auto it = copy_of_root.find(root);
+        if (it == copy_of_root.end())
+        {
+          it =
+            copy_of_root.emplace(root, static_cast<std::uint32_t>(points.size())).first;
+          points.push_back(points[v]);
+        }
+        for (auto &node : tets[list[i]])
+          if (node == v)
+            node = it->second;
+      }
+    }
+    mesh.tets = std::move(tets);
+    return stats;
+  }
+
+  inline double
+  mesh_volume(const Mesh &mesh)
+  {
+    double v = 0;
+    for (const auto &t : mesh.tets)
+      v += volume(mesh.points[t[0]],
+                  mesh.points[t[1]],
+                  mesh.points[t[2]],
+                  mesh.points[t[3]]);
+    return v;
+  }
+
+  inline double
+  min_tet_volume(const Mesh &mesh)
+  {
+    double v = 1e300;
+    for (const auto &t : mesh.tets)
+      v = std::min(v,
+                   volume(mesh.points[t[0]],
+                          mesh.points[t[1]],
+                          mesh.points[t[2]],
+                          mesh.points[t[3]]));
+    return v;
+  }
+
+  /**
+   * Checks that the mesh is conforming: every face is shared by at most two
+   * tetrahedra; a face of only one lies on the domain boundary (as told by
+   * @p on_boundary) or is one sheet of a cut (on one of @p planes, with the other sheet
+   * at the same position). A hanging vertex would leave unmatched faces inside.
+   * Returns an empty string if so, otherwise a description of the first problem.
+   */
+  template <typename OnBoundary>
+  std::string
+  conformity_error(const Mesh               &mesh,
+                   const OnBoundary         &on_boundary,
+                   const std::vector<Plane> &planes)
+  {
+    std::map<std::array<std::uint32_t, 3>, unsigned> count;
+    for (const auto &t : mesh.tets)
+      for (unsigned f = 0; f < 4; ++f)
+        ++count[sorted(t[(f + 1) % 4], t[(f + 2) % 4], t[(f + 3) % 4])];
+    std::map<std::array<Point, 3>, unsigned> sheets;
+    for (const auto &[f, c] : count)
+    {
+      if (c > 2)
+        return "face shared by more than two tetrahedra";
+      if (c == 2)
+        continue;
+      std::array<Point, 3> p{mesh.points[f[0]], mesh.points[f[1]], mesh.points[f[2]]};
+      if (on_boundary(p))
+        continue;
+      bool on_plane = false;
+      for (const auto &plane : planes)
+        on_plane |= std::abs(plane(p[0])) < 1e-9 && std::abs(plane(p[1])) < 1e-9
+                    && std::abs(plane(p[2])) < 1e-9;
+      if (!on_plane)
+      {
+        std::ostringstream s;
+        s << "unmatched interior face at (" << p[0][0] << "," << p[0][1] << "," << p[0][2]
+          << ")";
+        return s.str();
+      }
+      std::sort(p.begin(), p.end());
+      ++sheets[p];
+    }
+    for (const auto &[p, c] : sheets)
+      if (c != 2)
+        return "cut face without its opposite sheet (hanging vertex on the cut?)";
+    return {};
+  }
+
+  /**
+   * Connected components of the mesh through shared faces: the volume of each.
+   */
+  inline std::vector<double>
+  component_volumes(const Mesh &mesh)
+  {
+    std::vector<std::size_t> parent(mesh.tets.size());
+    std::iota(parent.begin(), parent.end(), 0);
+    const auto find = [&](std::size_t i)
+    {
+      while (parent[i] != i)
+        i = parent[i] = parent[parent[i]];
+      return i;
+    };
+    std::map<std::array<std::uint32_t, 3>, std::size_t> first;
+    for (std::size_t k = 0; k < mesh.tets.size(); ++k)
+      for (unsigned f = 0; f < 4; ++f)
+      {
+        const auto &t    = mesh.tets[k];
+        const auto  face = sorted(t[(f + 1) % 4], t[(f + 2) % 4], t[(f + 3) % 4]);
+        const auto [it, inserted] = first.emplace(face, k);
+        if (!inserted)
+          parent[find(k)] = find(it->second);
+      }
+    std::map<std::size_t, double> v;
+    for (std::size_t k = 0; k < mesh.tets.size(); ++k)
+    {
+      const auto &t = mesh.tets[k];
+      v[find(k)] += volume(mesh.points[t[0]],
+                           mesh.points[t[1]],
+                           mesh.points[t[2]],
+                           mesh.points[t[3]]);
+    }
+    std::vector<double> result;
+    for (const auto &[root, vol] : v)
+      result.push_back(vol);
+    std::sort(result.begin(), result.end());
+    return result;
+  }
+
+  /**
+   * A box [0,1]^3 of n^3 cubes, each split into six tetrahedra around its main
+   * diagonal (a conforming Kuhn triangulation), with vertex ids shuffled so that the
+   * global order has no relation to the geometry.
+   */
+  inline Mesh
+  box_mesh(const unsigned n, std::mt19937 &rng)
+  {
+    Mesh       mesh;
+    const auto index = [n](unsigned i, unsigned j, unsigned k)
+    { return (k * (n + 1) + j) * (n + 1) + i; };
+    std::vector<std::uint32_t> shuffle((n + 1) * (n + 1) * (n + 1));
+    std::iota(shuffle.begin(), shuffle.end(), 0u);
+    std::shuffle(shuffle.begin(), shuffle.end(), rng);
+    mesh.points.resize(shuffle.size());
+    for (unsigned k = 0; k <= n; ++k)
+      for (unsigned j = 0; j <= n; ++j)
+        for (unsigned i = 0; i <= n; ++i)
+          mesh.points[shuffle[index(i, j, k)]] = {double(i) / n,
+                                                  double(j) / n,
+                                                  double(k) / n};
+    // The six paths from corner (0,0,0) to (1,1,1) of the unit cube.
+    const std::array<std::array<unsigned, 3>, 6> paths = {
+      {{{0, 1, 2}}, {{0, 2, 1}}, {{1, 0, 2}}, {{1, 2, 0}}, {{2, 0, 1}}, {{2, 1, 0}}}};
+    for (unsigned k = 0; k < n; ++k)
+      for (unsigned j = 0; j < n; ++j)
+        for (unsigned i = 0; i < n; ++i)
+          for (const auto &path : paths)
+          {
+            std::array<unsigned, 3>      c{i, j, k};
+            std::array<std::uint32_t, 4> t;
+            t[0] = shuffle[index(c[0], c[1], c[2])];
+            for (unsigned s = 0; s < 3; ++s)
+            {
+              ++c[path[s]];
+              t[s + 1] = shuffle[index(c[0], c[1], c[2])];
+            }
+            const auto &x = mesh.points;
+            if (volume(x[t[0]], x[t[1]], x[t[2]], x[t[3]]) < 0)
+              std::swap(t[0], t[1]);
+            mesh.tets.push_back(t);
+          }
+    return mesh;
+  }
+
+  /**
+   * Whether three points lie on one face of the box [0,1]^3.
+   */
+  inline bool
+  on_box_boundary(const std::array<Point, 3> &p)
+  {
+    for (unsigned k = 0; k < 3; ++k)
+      for (const double w : {0.0, 1.0})
+        if (p[0][k] == w && p[1][k] == w && p[2][k] == w)
+          return true;
+    return false;
+  }
+} // namespace lacerta::cut::test_support
