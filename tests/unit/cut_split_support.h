@@ -214,6 +214,8 @@ namespace lacerta::cut::test_support
     Plane plane;
     bool  has_front = false;
     Plane front;
+    /** Identifies one cut across the steps that sweep it. */
+    int id = 0;
 
     double
     behind(const Point &x) const
@@ -229,6 +231,13 @@ namespace lacerta::cut::test_support
   {
     std::vector<Point>                        points;
     std::vector<std::array<std::uint32_t, 4>> tets;
+    /**
+     * Points known to lie on the cut surface `surface` (snapped vertices keep that
+     * status while the cut proceeds, and so do their copies), as a real cutter stores
+     * it with the cut surface.
+     */
+    std::vector<bool> on_surface;
+    int               surface = -1;
   };
 
   inline std::array<std::uint32_t, 3>
@@ -247,6 +256,7 @@ namespace lacerta::cut::test_support
   struct CutAnalysis
   {
     std::vector<std::int8_t>                                  side;
+    std::vector<bool>                                         on_plane;
     std::map<std::pair<std::uint32_t, std::uint32_t>, double> edge_t;
     std::map<std::array<std::uint32_t, 3>, Point>             front_points;
     std::vector<std::size_t>                                  affected;
@@ -276,36 +286,65 @@ namespace lacerta::cut::test_support
       for (const auto &e : tet_edge_vertices)
         edges.insert({std::min(t[e[0]], t[e[1]]), std::max(t[e[0]], t[e[1]])});
 
-    // Snapping, once per mesh edge: a reached crossing close to an end moves there.
-    std::vector<bool> on_cut(n, false);
+    // Snapping, once per mesh edge, from the whole plane (not only the part the crack
+    // has reached): a crossing close to an end moves there. Deciding it from the final
+    // surface makes a cut in many steps snap exactly as one stroke does. A snapped
+    // vertex joins the cut when the crack reaches it; its edges are never cut.
+    std::vector<bool> on_plane(n, false), reached(n, false);
     for (std::size_t v = 0; v < n; ++v)
-      on_cut[v] = d[v] == 0 && surface.behind(x[v]) < 0;
+    {
+      on_plane[v] = d[v] == 0
+                    || (mesh.surface == surface.id && v < mesh.on_surface.size()
+                        && mesh.on_surface[v]);
+      reached[v] = surface.behind(x[v]) < 0;
+    }
     for (const auto &[i, j] : edges)
       if (d[i] * d[j] < 0)
       {
-        const double t = d[i] / (d[i] - d[j]);
-        if (surface.behind(lerp(x[i], x[j], t)) >= 0)
-          continue;
-        const EdgeSnap s = snap_edge_parameter(t, eps);
+        const EdgeSnap s = snap_edge_parameter(d[i] / (d[i] - d[j]), eps);
         if (s == EdgeSnap::first_vertex)
-          on_cut[i] = true;
+          on_plane[i] = true;
         else if (s == EdgeSnap::second_vertex)
-          on_cut[j] = true;
+          on_plane[j] = true;
       }
+    // The crack front must not cross an edge lying in the cut surface (the table puts
+    // front points inside faces only): vertices on the surface joined by such edges are
+    // reached as a group, when all of them are.
+    {
+      std::vector<std::size_t> group(n);
+      std::iota(group.begin(), group.end(), 0);
+      const auto find = [&](std::size_t i)
+      {
+        while (group[i] != i)
+          i = group[i] = group[group[i]];
+        return i;
+      };
+      for (const auto &[i, j] : edges)
+        if (on_plane[i] && on_plane[j])
+          group[find(i)] = find(j);
+      std::vector<bool> all_reached(n, true);
+      for (std::size_t v = 0; v < n; ++v)
+        if (on_plane[v] && !reached[v])
+          all_reached[find(v)] = false;
+      for (std::size_t v = 0; v < n; ++v)
+        if (on_plane[v])
+          reached[v] = all_reached[find(v)];
+    }
     a.side.resize(n);
     for (std::size_t v = 0; v < n; ++v)
-      a.side[v] =
-        on_cut[v] ? 0 : (d[v] >= 0 ? 1 : -1); // unreached points on the plane: +
+      a.side[v] = on_plane[v] && reached[v] ? 0 : (d[v] >= 0 ? 1 : -1);
+    a.on_plane = on_plane;
 
-    // Cut edges: opposite sides and reached.
+    // Section corners: vertices on the plane, and crossings of edges whose ends are both
+    // off the plane. Cut edges are the reached crossings.
     std::map<std::pair<std::uint32_t, std::uint32_t>, bool> crossing_reached;
     for (const auto &[i, j] : edges)
-      if (a.side[i] * a.side[j] < 0)
+      if (!on_plane[i] && !on_plane[j] && d[i] * d[j] < 0)
       {
         const double t           = d[i] / (d[i] - d[j]);
-        const bool   reached     = surface.behind(lerp(x[i], x[j], t)) < 0;
-        crossing_reached[{i, j}] = reached;
-        if (reached)
+        const bool   is_cut      = surface.behind(lerp(x[i], x[j], t)) < 0;
+        crossing_reached[{i, j}] = is_cut;
+        if (is_cut)
           a.edge_t[{i, j}] = t;
       }
 
@@ -318,9 +357,13 @@ namespace lacerta::cut::test_support
       for (const auto &f : faces)
       {
         std::vector<std::pair<Point, bool>> corners; // position, reached
+        unsigned                            vertex_corners = 0;
         for (unsigned k = 0; k < 3; ++k)
-          if (a.side[f[k]] == 0)
-            corners.push_back({x[f[k]], true});
+          if (on_plane[f[k]])
+          {
+            corners.push_back({x[f[k]], reached[f[k]]});
+            ++vertex_corners;
+          }
         for (unsigned k = 0; k < 3; ++k)
           for (unsigned l = k + 1; l < 3; ++l)
           {
@@ -330,7 +373,8 @@ namespace lacerta::cut::test_support
             const double t = d[f[k]] / (d[f[k]] - d[f[l]]);
             corners.push_back({lerp(x[f[k]], x[f[l]], t), it->second});
           }
-        if (corners.size() != 2 || corners[0].second == corners[1].second)
+        if (corners.size() != 2 || corners[0].second == corners[1].second
+            || vertex_corners == 2)
           continue;
         const auto  &r  = corners[0].second ? corners[0] : corners[1];
         const auto  &u  = corners[0].second ? corners[1] : corners[0];
@@ -434,6 +478,8 @@ namespace lacerta::cut::test_support
     std::vector<bool>                         replaced(mesh.tets.size(), false);
     std::set<std::array<std::uint32_t, 3>>    cut_faces;
     std::vector<Point>                       &points = mesh.points;
+    mesh.surface                                     = surface.id;
+    mesh.on_surface                                  = a.on_plane;
 
     SplitResult r;
     for (std::size_t k = 0; k < a.cuts.size(); ++k)
@@ -468,6 +514,7 @@ namespace lacerta::cut::test_support
           {
             t[j] = static_cast<std::uint32_t>(points.size());
             points.push_back(p[j]);
+            mesh.on_surface.push_back(n.kind != NodeKind::interior_point);
             ids.emplace(key, t[j]);
           }
         }
@@ -524,6 +571,7 @@ namespace lacerta::cut::test_support
           it =
             copy_of_root.emplace(root, static_cast<std::uint32_t>(points.size())).first;
           points.push_back(points[v]);
+          mesh.on_surface.push_back(true);
         }
         for (auto &node : tets[list[i]])
           if (node == v)
@@ -562,34 +610,40 @@ namespace lacerta::cut::test_support
   /**
    * Checks that the mesh is conforming: every face is shared by at most two
    * tetrahedra; a face of only one lies on the domain boundary (as told by
-   * @p on_boundary) or is one sheet of a cut (on one of @p planes, with the other sheet
-   * at the same position). A hanging vertex would leave unmatched faces inside.
-   * Returns an empty string if so, otherwise a description of the first problem.
+   * @p on_boundary) or on one of the cut @p planes; and these boundary faces close up
+   * (every edge of theirs is used an even number of times). A hanging vertex leaves an
+   * unmatched face inside or an odd boundary edge. The two sheets of a cut are separate
+   * surfaces and need not be triangulated alike. Snapping moves the cut surface off the
+   * plane, by up to @p tolerance. Returns an empty string if conforming, otherwise a
+   * description of the first problem.
    */
   template <typename OnBoundary>
   std::string
   conformity_error(const Mesh               &mesh,
                    const OnBoundary         &on_boundary,
-                   const std::vector<Plane> &planes)
+                   const std::vector<Plane> &planes,
+                   const double              tolerance = 1e-9)
   {
     std::map<std::array<std::uint32_t, 3>, unsigned> count;
     for (const auto &t : mesh.tets)
       for (unsigned f = 0; f < 4; ++f)
         ++count[sorted(t[(f + 1) % 4], t[(f + 2) % 4], t[(f + 3) % 4])];
-    std::map<std::array<Point, 3>, unsigned> sheets;
+    std::map<std::pair<std::uint32_t, std::uint32_t>, unsigned> boundary_edges;
     for (const auto &[f, c] : count)
     {
       if (c > 2)
         return "face shared by more than two tetrahedra";
       if (c == 2)
         continue;
-      std::array<Point, 3> p{mesh.points[f[0]], mesh.points[f[1]], mesh.points[f[2]]};
-      if (on_boundary(p))
-        continue;
-      bool on_plane = false;
+      const std::array<Point, 3> p{mesh.points[f[0]],
+                                   mesh.points[f[1]],
+                                   mesh.points[f[2]]};
+      bool                       on_plane = on_boundary(p);
       for (const auto &plane : planes)
-        on_plane |= std::abs(plane(p[0])) < 1e-9 && std::abs(plane(p[1])) < 1e-9
-                    && std::abs(plane(p[2])) < 1e-9;
+        on_plane =
+          on_plane
+          || (std::abs(plane(p[0])) <= tolerance && std::abs(plane(p[1])) <= tolerance
+              && std::abs(plane(p[2])) <= tolerance);
       if (!on_plane)
       {
         std::ostringstream s;
@@ -597,12 +651,13 @@ namespace lacerta::cut::test_support
           << ")";
         return s.str();
       }
-      std::sort(p.begin(), p.end());
-      ++sheets[p];
+      ++boundary_edges[{f[0], f[1]}];
+      ++boundary_edges[{f[0], f[2]}];
+      ++boundary_edges[{f[1], f[2]}];
     }
-    for (const auto &[p, c] : sheets)
-      if (c != 2)
-        return "cut face without its opposite sheet (hanging vertex on the cut?)";
+    for (const auto &[e, c] : boundary_edges)
+      if (c % 2 != 0)
+        return "boundary does not close up at an edge (hanging vertex?)";
     return {};
   }
 
