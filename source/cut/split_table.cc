@@ -572,7 +572,6 @@ namespace lacerta::cut
       std::array<std::uint8_t, 4> nodes;
       std::uint8_t                cut_faces;
       std::uint8_t                vertex_mask; // off-cut vertices deciding the side
-      std::uint8_t                copy_vertex; // a vertex whose side a copy node takes
     };
 
     struct TableEntry
@@ -644,17 +643,12 @@ namespace lacerta::cut
         for (const auto &t : pieces[p])
         {
           TableChild c{};
-          c.copy_vertex = no_vertex;
           for (unsigned k = 0; k < 4; ++k)
           {
             const std::uint8_t id = t[k] == steiner_node ? interior_node : t[k];
             c.nodes[k]            = id;
             if (id < 4 && !(cfg.vertices & (1u << id)))
               c.vertex_mask |= static_cast<std::uint8_t>(1u << id);
-            if (id >= 4 && id < 10 && cfg.kind != CutKind::refinement)
-              c.copy_vertex = static_cast<std::uint8_t>(tet_edge_vertices[id - 4][0]);
-            if (id >= 10 && id < 16)
-              c.copy_vertex = static_cast<std::uint8_t>(tet_edge_vertices[id - 10][1]);
           }
           if (c.vertex_mask == 0)
             c.vertex_mask = static_cast<std::uint8_t>(piece_vertices[p]);
@@ -1259,28 +1253,34 @@ namespace lacerta::cut
     result.kind       = entry->kind;
     result.entry      = index;
     result.n_children = entry->n_children;
-    for (unsigned c = 0; c < entry->n_children; ++c)
+
+    // The side every local node id takes, without branching per node: a separated edge
+    // point takes the side of the endpoint its copy belongs to; a vertex on the cut
+    // takes the side of its child (multiplier 1); everything else 0.
+    std::array<std::int8_t, n_node_ids> base{}, on_cut_multiplier{};
+    if (separates)
     {
-      const TableChild &tc  = T.children[entry->first_child + c];
-      Child            &out = result.children[c];
-      int               side;
-      if (tc.copy_vertex != no_vertex)
-        side = cut.vertex_side[P.to_local[tc.copy_vertex]];
-      else
-      {
-        const unsigned m = P.vertices_to_local[tc.vertex_mask];
-        side             = (m & plus) ? ((m & minus) ? 0 : 1) : ((m & minus) ? -1 : 0);
-      }
-      out.side      = static_cast<std::int8_t>(side);
-      out.cut_faces = tc.cut_faces;
+      for (unsigned id = 4; id < 16; ++id)
+        base[id] = cut.vertex_side[T.node_vertex[id]];
+      for (unsigned v = 0; v < 4; ++v)
+        on_cut_multiplier[v] = cut.vertex_side[v] == 0;
+    }
+    const TableChild *tc = &T.children[entry->first_child];
+    for (unsigned c = 0; c < entry->n_children; ++c, ++tc)
+    {
+      Child &out = result.children[c];
+      // The child's side from its vertices off the cut (0 if they disagree: only
+      // ahead of a crack front). A child using a separated copy has all of them on the
+      // copy's side.
+      const unsigned m    = P.vertices_to_local[tc->vertex_mask];
+      const int      side = int((m & plus) != 0) - int((m & minus) != 0);
+      out.side            = static_cast<std::int8_t>(side);
+      out.cut_faces       = tc->cut_faces;
       for (unsigned k = 0; k < 4; ++k)
       {
-        const std::uint8_t local = P.node_to_local[tc.nodes[k]];
+        const std::uint8_t local = P.node_to_local[tc->nodes[k]];
         NodeRef            r     = T.node_ref[local];
-        if (r.kind == NodeKind::edge_point && separates)
-          r.side = cut.vertex_side[T.node_vertex[local]];
-        else if (r.kind == NodeKind::vertex && cut.vertex_side[r.index] == 0 && separates)
-          r.side = out.side;
+        r.side = static_cast<std::int8_t>(base[local] + on_cut_multiplier[local] * side);
         out.nodes[k] = r;
       }
       if (flip)
