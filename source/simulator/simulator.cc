@@ -8,6 +8,7 @@
 #include <lacerta/simulator/simulator.h>
 
 #include <deal.II/base/timer.h>
+#include <deal.II/base/utilities.h>
 
 #include <chrono>
 #include <cmath>
@@ -47,6 +48,52 @@ namespace lacerta
         }
       }
       return {largest, where};
+    }
+
+
+    /**
+     * Appends the lines of @p file to @p text, replacing every `include name` line by
+     * the lines of that file (recursively). deal.II looks for included files in the
+     * working directory; a scene variant includes its base scene by a name relative to
+     * itself, so included names are resolved from the including file's directory first.
+     */
+    void
+    append_with_includes(const std::string &file,
+                         std::ostream      &text,
+                         const unsigned int depth)
+    {
+      if (depth > 16)
+        throw_error("Parameter file '",
+                    file,
+                    "': includes are nested too deeply (a cycle?).");
+      std::ifstream in(file);
+      if (!in)
+        throw_error("Parameter file '", file, "' cannot be opened.");
+      const std::filesystem::path directory = std::filesystem::path(file).parent_path();
+      unsigned int                number    = 0;
+      for (std::string line; std::getline(in, line);)
+      {
+        ++number;
+        const std::string trimmed = dealii::Utilities::trim(line);
+        if (trimmed.rfind("include ", 0) != 0)
+        {
+          text << line << '\n';
+          continue;
+        }
+        const std::string     name = dealii::Utilities::trim(trimmed.substr(8));
+        std::filesystem::path path(name);
+        if (path.is_relative() && std::filesystem::exists(directory / path))
+          path = directory / path;
+        if (!std::filesystem::exists(path))
+          throw_error("Parameter file '",
+                      file,
+                      "', line ",
+                      number,
+                      ": the included file '",
+                      name,
+                      "' cannot be opened.");
+        append_with_includes(path.string(), text, depth + 1);
+      }
     }
   } // namespace
 
@@ -121,12 +168,15 @@ namespace lacerta
     if (!std::ifstream(file))
       throw_error("Parameter file '", file, "' cannot be opened.");
     set_input_directory(std::filesystem::path(file).parent_path().string());
+    std::ostringstream text;
+    append_with_includes(file, text, 0);
 
     const auto parse = [&](dealii::ParameterHandler &handler, const bool skip_undefined)
     {
       try
       {
-        handler.parse_input(file, "", skip_undefined);
+        std::istringstream input(text.str());
+        handler.parse_input(input, file, "", skip_undefined);
       }
       catch (const dealii::ExceptionBase &e)
       {

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# The README's quick start on a fresh Debian 12 machine:
+#   bash contrib/setup/quickstart.sh run    installs, builds, runs prm/square_pull.prm
+#   bash contrib/setup/quickstart.sh test   installs, builds, runs the whole CTest suite
+set -euo pipefail
+
+mode="${1:-run}"
+top="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+build="${LACERTA_BUILD_DIR:-$top/build}"
+
+bash "$top/contrib/setup/install-dependencies.sh"
+
+cmake -S "$top" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake --build "$build" --parallel "$(nproc)"
+
+case "$mode" in
+  run)
+    cd "$top"
+    "$build/lacerta" prm/square_pull.prm
+    echo "Results: $top/output/square_pull (open solution.pvd in ParaView)"
+    ;;
+  test)
+    # Allow mpirun as root (CI runs as root) for the MPI tests.
+    export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+    ctest --test-dir "$build" --parallel "$(nproc)" --output-on-failure --timeout 900
+    ;;
+  *)
+    echo "usage: $0 run|test" >&2
+    exit 2
+    ;;
+esac

@@ -1,0 +1,81 @@
+// Masses (Section 3.1) and spring stiffnesses (Section 3.2).
+
+#include <deal.II/base/function_parser.h>
+
+#include <gtest/gtest.h>
+
+#include "physics_test_support.h"
+#include <numeric>
+
+using namespace lacerta;
+
+TEST(Assembly, TotalMassIsTheIntegralOfANonUniformDensityOnADistortedMesh)
+{
+  const mesh::TetMesh mesh =
+    test_support::distorted_box(4, 0.25, dealii::Point<3>(1.0, 2.0, 0.5));
+  dealii::FunctionParser<3> density(1);
+  density.initialize("x,y,z", "1000*(1 + x + y*y + x*z)", {});
+  const std::vector<double> masses = physics::compute_masses(mesh, density);
+  const double              total  = std::accumulate(masses.begin(), masses.end(), 0.0);
+  // ∫ over [0,1]x[0,2]x[0,.5] of 1 + x + y² + xz = 1 + 0.5 + 8/3 + 0.0625 per unit of
+  // the x and z extents: 1*2*.5 + .5*2*.5 + (8/3)*1*.5 + (.5*.125)*2.
+  const double exact = 1000 * (1.0 + 0.5 + 4.0 / 3.0 + 0.125);
+  EXPECT_NEAR(total, exact, 1e-12 * exact);
+  for (const double m : masses)
+    EXPECT_GT(m, 0.0);
+}
+
+
+TEST(Assembly, EachTetrahedronGivesItsVerticesItsOwnMass)
+{
+  // One tetrahedron, quadratic density: Σ m_i = ∫_τ σ exactly, and m_i = ∫ σ c_i.
+  const mesh::TetMesh       mesh({{0, 0, 0}, {2, 0, 0}, {0, 1, 0}, {0, 0, 3}},
+                           {{0, 1, 2, 3}},
+                           "tet");
+  dealii::FunctionParser<3> density(1);
+  density.initialize("x,y,z", "x*x", {});
+  const std::vector<double> masses = physics::compute_masses(mesh, density);
+  // ∫ x² over the tet = 6 V * 2! / 5! * Σ_{i<=j} x_i x_j = 6 * 1 * 2/120 * 4 = 0.4.
+  EXPECT_NEAR(std::accumulate(masses.begin(), masses.end(), 0.0), 0.4, 1e-14);
+  // ∫ x² c_1 (c_1 = x/2) = ∫ x³/2 = 6 V * 3!/6! * 8 / 2 = 0.2.
+  EXPECT_NEAR(masses[1], 0.2, 1e-14);
+}
+
+
+TEST(Assembly, StiffnessOfOneTetrahedronByHand)
+{
+  // Unit corner tetrahedron, E = 2: V = 1/6; edges of length 1 get 2 * (1/6) / 1 = 1/3,
+  // edges of length √2 get 2 * (1/6) / 2 = 1/6.
+  const mesh::TetMesh      mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+                           {{0, 1, 2, 3}},
+                           "tet");
+  const physics::SpringSet springs =
+    physics::compute_springs(mesh, dealii::Functions::ConstantFunction<3>(2.0));
+  ASSERT_EQ(springs.size(), 6u);
+  for (std::size_t s = 0; s < springs.size(); ++s)
+  {
+    const bool from_origin = (springs.a[s] == 0 || springs.b[s] == 0);
+    EXPECT_NEAR(springs.rest_length[s], from_origin ? 1.0 : std::sqrt(2.0), 1e-15);
+    EXPECT_NEAR(springs.stiffness[s], from_origin ? 1.0 / 3.0 : 1.0 / 6.0, 1e-15);
+  }
+}
+
+
+TEST(Assembly, StiffnessSumsOverTheTetrahedraAroundAnEdge)
+{
+  // Two tets sharing the face (1, 2, 3); E = 1 on both.
+  const mesh::TetMesh      mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}},
+                           {{0, 1, 2, 3}, {1, 3, 2, 4}},
+                           "two tets");
+  const physics::SpringSet springs =
+    physics::compute_springs(mesh, dealii::Functions::ConstantFunction<3>(1.0));
+  const double v0 = mesh.volume(0), v1 = mesh.volume(1);
+  for (std::size_t s = 0; s < springs.size(); ++s)
+  {
+    const unsigned int a = springs.a[s], b = springs.b[s];
+    const bool         in0 = a <= 3 && b <= 3;
+    const bool         in1 = a >= 1 && b >= 1;
+    const double       l2  = springs.rest_length[s] * springs.rest_length[s];
+    EXPECT_NEAR(springs.stiffness[s], ((in0 ? v0 : 0) + (in1 ? v1 : 0)) / l2, 1e-14);
+  }
+}

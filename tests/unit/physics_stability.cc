@@ -1,0 +1,282 @@
+// Integrators and stability control: energy behaviour, the critical time step bound
+// against the true limit from an eigen-solver, and blow-up detection.
+
+#include <lacerta/base/exceptions.h>
+#include <lacerta/physics/integrator.h>
+#include <lacerta/physics/stability.h>
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include "physics_test_support.h"
+#include <random>
+
+using namespace lacerta;
+
+namespace
+{
+  /**
+   * The true highest angular eigenfrequency of M⁻¹K at the current positions, from the
+   * dense tangent stiffness (with the geometric term) of the free particles.
+   */
+  double
+  true_highest_frequency(const physics::ParticleSystem &system)
+  {
+    const unsigned int n = system.n_particles();
+    Eigen::MatrixXd    k = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+    const auto        &x = system.position;
+    for (std::size_t s = 0; s < system.springs.size(); ++s)
+    {
+      const unsigned int i = system.springs.a[s], j = system.springs.b[s];
+      Eigen::Vector3d    d(x[3 * j] - x[3 * i],
+                        x[3 * j + 1] - x[3 * i + 1],
+                        x[3 * j + 2] - x[3 * i + 2]);
+      const double       length = d.norm();
+      d /= length;
+      const double    ks = system.springs.stiffness[s];
+      const double    g  = ks * (1 - system.springs.rest_length[s] / length);
+      Eigen::Matrix3d block =
+        (ks - g) * d * d.transpose() + g * Eigen::Matrix3d::Identity();
+      k.block<3, 3>(3 * i, 3 * i) += block;
+      k.block<3, 3>(3 * j, 3 * j) += block;
+      k.block<3, 3>(3 * i, 3 * j) -= block;
+      k.block<3, 3>(3 * j, 3 * i) -= block;
+    }
+    std::vector<unsigned int> free_dofs;
+    for (unsigned int i = 0; i < n; ++i)
+      if (system.free[i] > 0)
+        for (unsigned int d = 0; d < 3; ++d)
+          free_dofs.push_back(3 * i + d);
+    Eigen::MatrixXd a(free_dofs.size(), free_dofs.size());
+    for (std::size_t r = 0; r < free_dofs.size(); ++r)
+      for (std::size_t c = 0; c < free_dofs.size(); ++c)
+        a(r, c) =
+          k(free_dofs[r], free_dofs[c])
+          / std::sqrt(system.mass[free_dofs[r] / 3] * system.mass[free_dofs[c] / 3]);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(a, Eigen::EigenvaluesOnly);
+    return std::sqrt(eigen.eigenvalues().maxCoeff());
+  }
+
+
+  void
+  perturb(std::vector<double> &values, const double amplitude, const unsigned int seed)
+  {
+    std::mt19937                           random(seed);
+    std::uniform_real_distribution<double> uniform(-amplitude, amplitude);
+    for (double &v : values)
+      v += uniform(random);
+  }
+
+
+  double
+  mechanical_energy(const physics::ParticleSystem &system)
+  {
+    return system.kinetic_energy() + system.elastic_energy();
+  }
+} // namespace
+
+
+TEST(Stability, BoundIsAboveTheTrueFrequencyAndWithinFactorTwo)
+{
+  struct Case
+  {
+    unsigned int n;
+    double       distortion;
+    double       stretch; // random position perturbation relative to the cell size
+    bool         clamp;
+  };
+  for (const Case c : {Case{1, 0.0, 0.0, false},
+                       Case{2, 0.0, 0.0, true},
+                       Case{2, 0.3, 0.0, false},
+                       Case{3, 0.3, 0.0, true},
+                       Case{3, 0.2, 0.15, false},
+                       Case{3, 0.0, 0.3, true}})
+  {
+    const mesh::TetMesh mesh =
+      test_support::distorted_box(c.n, c.distortion, dealii::Point<3>(0.1, 0.05, 0.02));
+    auto system = test_support::make_system(mesh, 1000, 1e5);
+    if (c.clamp)
+      for (unsigned int i = 0; i < system->n_particles(); ++i)
+        if (system->position[3 * i] < 1e-12)
+          system->free[i] = 0;
+    perturb(system->position, c.stretch * 0.02 / c.n, c.n);
+    const double true_omega = true_highest_frequency(*system);
+    const double bound      = physics::bound_highest_frequency(*system).omega;
+    EXPECT_GE(bound, true_omega * (1 - 1e-12)) << "n = " << c.n;
+    EXPECT_LE(bound, 2.0 * true_omega) << "n = " << c.n;
+    // So every integrator's time step from the bound is safe and at least half the true
+    // one.
+    for (const auto &[name, entry] : physics::IntegratorRegistry::plugins())
+    {
+      if (name == "explicit_euler")
+        continue;
+      const auto   integrator = physics::IntegratorRegistry::create(name);
+      const double from_bound = integrator->critical_time_step(bound, 0, 0);
+      const double true_limit = integrator->critical_time_step(true_omega, 0, 0);
+      EXPECT_LE(from_bound, true_limit * (1 + 1e-12)) << name;
+      EXPECT_GE(from_bound, 0.5 * true_limit) << name;
+    }
+  }
+}
+
+
+TEST(Stability, SymplecticIntegratorsKeepEnergyBoundedOver10000Steps)
+{
+  const mesh::TetMesh mesh =
+    test_support::distorted_box(2, 0.2, dealii::Point<3>(0.1, 0.1, 0.1));
+  for (const std::string name : {"symplectic_euler", "velocity_verlet"})
+  {
+    auto system = test_support::make_system(mesh, 1000, 1e5);
+    perturb(system->position, 0.002, 7);
+    const auto integrator = physics::IntegratorRegistry::create(name);
+    integrator->initialize(*system);
+    const double dt =
+      0.5 * integrator->critical_time_step(true_highest_frequency(*system), 0, 0);
+    const double initial           = mechanical_energy(*system);
+    double       largest_deviation = 0, first_window = 0, last_window = 0;
+    for (unsigned int step = 0; step < 10000; ++step)
+    {
+      integrator->step(*system, step * dt, dt);
+      const double energy = mechanical_energy(*system);
+      largest_deviation   = std::max(largest_deviation, std::abs(energy - initial));
+      (step < 1000 ? first_window : last_window) +=
+        (step < 1000 || step >= 9000) ? energy / 1000 : 0;
+    }
+    // A symplectic scheme conserves a modified energy: the true one oscillates by
+    // O(ω dt) (symplectic Euler, velocities half a step off) or O((ω dt)²) (Verlet)
+    // around it, at ω dt = 1 here, but it never drifts.
+    EXPECT_LT(largest_deviation, (name == "velocity_verlet" ? 0.25 : 0.75) * initial)
+      << name;
+    EXPECT_NEAR(last_window, first_window, 0.02 * first_window) << name;
+  }
+}
+
+
+TEST(Stability, Rk4LosesEnergySlowlyAndExplicitEulerGainsIt)
+{
+  const mesh::TetMesh mesh =
+    test_support::distorted_box(2, 0.2, dealii::Point<3>(0.1, 0.1, 0.1));
+  for (const std::string name : {"rk4", "explicit_euler"})
+  {
+    auto system = test_support::make_system(mesh, 1000, 1e5);
+    perturb(system->position, 0.002, 7);
+    const auto integrator = physics::IntegratorRegistry::create(name);
+    integrator->initialize(*system);
+    const double dt      = 0.1 / true_highest_frequency(*system);
+    const double initial = mechanical_energy(*system);
+    for (unsigned int step = 0; step < 2000; ++step)
+      integrator->step(*system, step * dt, dt);
+    if (name == "rk4")
+    {
+      EXPECT_LE(mechanical_energy(*system), initial * (1 + 1e-9));
+      EXPECT_GT(mechanical_energy(*system), 0.5 * initial);
+    }
+    else
+      EXPECT_GT(mechanical_energy(*system), 1.1 * initial);
+  }
+}
+
+
+TEST(Stability, AStepSlightlyAboveTheTrueLimitIsCaught)
+{
+  const mesh::TetMesh mesh =
+    test_support::distorted_box(2, 0.2, dealii::Point<3>(0.1, 0.1, 0.1));
+  for (const std::string name : {"symplectic_euler", "velocity_verlet", "rk4"})
+  {
+    auto system = test_support::make_system(mesh, 1000, 1e5);
+    perturb(system->position, 1e-4, 3);
+    const auto integrator = physics::IntegratorRegistry::create(name);
+    integrator->initialize(*system);
+    const double true_limit =
+      integrator->critical_time_step(true_highest_frequency(*system), 0, 0);
+    const double dt = 1.02 * true_limit;
+    // Before the run: the limit from the bound is below the step, so the simulator
+    // sub-steps or stops.
+    const double bound = physics::bound_highest_frequency(*system).omega;
+    EXPECT_LT(integrator->critical_time_step(bound, 0, 0), dt) << name;
+    // During the run: the blow-up monitor stops it with a message.
+    physics::BlowUpMonitor monitor(*system, 1.0);
+    bool                   caught = false;
+    try
+    {
+      for (unsigned int step = 1; step <= 20000; ++step)
+      {
+        integrator->step(*system, step * dt, dt);
+        if (step % 10 == 0)
+          monitor.check(*system, step, step * dt);
+      }
+    }
+    catch (const Error &e)
+    {
+      caught = std::string(e.what()).find("blew up at step") != std::string::npos;
+    }
+    EXPECT_TRUE(caught) << name;
+  }
+}
+
+
+TEST(Stability, MonitorAcceptsAStableDampedRunWithWorkInput)
+{
+  // A clamped box pulled by a moving face under gravity: energy enters through the
+  // prescribed motion and leaves through damping; no false alarm.
+  const mesh::TetMesh mesh =
+    test_support::distorted_box(3, 0.0, dealii::Point<3>(0.1, 0.03, 0.03));
+  auto system               = test_support::make_system(mesh, 1000, 1e5);
+  system->mass_damping      = 2;
+  system->body_acceleration = {0, 0, -9.81};
+  std::vector<unsigned int> pulled;
+  for (unsigned int i = 0; i < system->n_particles(); ++i)
+    if (system->position[3 * i] < 1e-12 || system->position[3 * i] > 0.1 - 1e-12)
+    {
+      system->free[i] = 0;
+      if (system->position[3 * i] > 0.05)
+        pulled.push_back(i);
+    }
+  system->enforce_constraints = [&](const double t, double *x, double *v)
+  {
+    for (const unsigned int i : pulled)
+    {
+      x[3 * i] = system->rest_position()[3 * i] + 0.01 * t;
+      v[3 * i] = 0.01;
+    }
+  };
+  const auto integrator = physics::IntegratorRegistry::create("velocity_verlet");
+  integrator->initialize(*system);
+  const double dt =
+    0.5
+    * integrator->critical_time_step(physics::bound_highest_frequency(*system).omega,
+                                     2,
+                                     0);
+  physics::BlowUpMonitor monitor(*system, 1.0);
+  for (unsigned int step = 1; step <= 5000; ++step)
+  {
+    integrator->step(*system, step * dt, dt);
+    if (step % 10 == 0)
+      EXPECT_NO_THROW(monitor.check(*system, step, step * dt));
+  }
+  EXPECT_GT(monitor.input_work(), 0.0);
+}
+
+
+TEST(Stability, ParallelForcesEqualSerialForces)
+{
+  const mesh::TetMesh mesh =
+    test_support::distorted_box(6, 0.2, dealii::Point<3>(0.1, 0.1, 0.1));
+  auto serial = test_support::make_system(mesh, 1000, 1e5, 1);
+  auto dual   = test_support::make_system(mesh, 1000, 1e5, 2);
+  perturb(serial->position, 0.002, 5);
+  perturb(serial->velocity, 0.1, 6);
+  serial->spring_damping = dual->spring_damping = 1e-3;
+  dual->position                                = serial->position;
+  dual->velocity                                = serial->velocity;
+  std::vector<double> a1(serial->position.size()), a2(serial->position.size());
+  serial->compute_acceleration(serial->position.data(),
+                               serial->velocity.data(),
+                               a1.data());
+  dual->compute_acceleration(dual->position.data(), dual->velocity.data(), a2.data());
+  double scale = 0;
+  for (const double a : a1)
+    scale = std::max(scale, std::abs(a));
+  for (std::size_t i = 0; i < a1.size(); ++i)
+    EXPECT_NEAR(a1[i], a2[i], 1e-12 * scale);
+}
