@@ -10,6 +10,7 @@
 #include <deal.II/base/timer.h>
 #include <deal.II/base/utilities.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -110,7 +111,7 @@ namespace lacerta
       "it used are copied there as parameters.prm.");
     prm.declare_entry("End time",
                       "1",
-                      dealii::Patterns::Double(0.0),
+                      dealii::Patterns::Double(0.0, 1e6),
                       "Simulated time at which the run stops [s].");
     prm.declare_entry(
       "Time step",
@@ -188,9 +189,14 @@ namespace lacerta
 
     // First pass: learn the constraint names, which declare subsections of their own.
     dealii::ParameterHandler first;
-    declare_parameters(first, {});
+    // The placeholder '<name>' of --help is declared too, so that the printed default
+    // file is itself a valid parameter file.
+    declare_parameters(first, {"<name>"});
     parse(first, true);
-    declare_parameters(prm, scene::Constraint::names(first));
+    std::vector<std::string> names = scene::Constraint::names(first);
+    if (std::find(names.begin(), names.end(), "<name>") == names.end())
+      names.push_back("<name>");
+    declare_parameters(prm, names);
     parse(prm, false);
   }
 
@@ -200,11 +206,12 @@ namespace lacerta
   {
     dealii::ParameterHandler prm;
     declare_parameters(prm, {"<name>"});
-    out << "Usage: lacerta <scene.prm>\n       lacerta --help\n\n"
-        << "The default parameter file, with every entry documented. Each plugin kind "
-           "lists its plugins in the documentation of its selector entry. The "
-           "constraints are named instances (Constraints/Names); '<name>' stands for "
-           "one of them.\n\n";
+    // Comment lines only, so that the output is itself a valid parameter file.
+    out << "# lacerta <scene.prm> runs a scene; lacerta --help prints this file.\n"
+        << "# The default parameter file, with every entry documented. Each plugin kind\n"
+        << "# lists its plugins in the documentation of its selector entry. Constraints\n"
+        << "# are named instances (Constraints/Names); '<name>' stands for one of "
+           "them.\n\n";
     prm.print_parameters(out, dealii::ParameterHandler::PRM);
   }
 

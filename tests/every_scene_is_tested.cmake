@@ -1,0 +1,12 @@
+# Every scene in prm/ must be run by a regression test tests/<scene>.prm.in.
+file(GLOB scenes ${SOURCE_DIR}/prm/*.prm)
+set(missing "")
+foreach(scene ${scenes})
+  get_filename_component(name ${scene} NAME_WE)
+  if(NOT EXISTS ${SOURCE_DIR}/tests/${name}.prm.in)
+    list(APPEND missing ${name})
+  endif()
+endforeach()
+if(missing)
+  message(FATAL_ERROR "scenes without a regression test in tests/: ${missing}")
+endif()
