@@ -3,6 +3,8 @@
 //
 //   lacerta-bench split            the figures
 //   lacerta-bench split --table    the table of cases (Markdown, for doc/split-table.md)
+//   lacerta-bench split --dump     one split per case, for
+//   contrib/plot/plot_split_cases.py
 
 #include <lacerta/cut/split_table.h>
 
@@ -120,7 +122,7 @@ namespace lacerta::bench
      * two section sides, and every edge code as a refinement.
      */
     std::vector<cut::TetCut>
-    all_configurations()
+    all_configurations(const bool every_order = true)
     {
       std::mt19937                           rng(1);
       std::uniform_real_distribution<double> param(0.15, 0.85);
@@ -179,20 +181,27 @@ namespace lacerta::bench
               for (auto &v : s)
                 v = -v;
             inputs.push_back(plane_cut(x, ids, s, p[0], n, false, {}, {}));
-            // Partial cuts: a front between every two crossing points, either way.
-            for (std::size_t a = 0; a < crossing.size(); ++a)
-              for (std::size_t b = a + 1; b < crossing.size(); ++b)
+            // Partial cuts: a front between every two section corners (vertices on the
+            // plane and crossing points), either way round.
+            std::vector<Point> corners = through;
+            for (const auto &e : crossing)
+            {
+              const double di = dot(n, sub(x[e[0]], p[0])),
+                           dj = dot(n, sub(x[e[1]], p[0]));
+              corners.push_back(lerp(x[e[0]], x[e[1]], di / (di - dj)));
+            }
+            for (std::size_t a = 0; a < corners.size(); ++a)
+              for (std::size_t b = a + 1; b < corners.size(); ++b)
                 for (const double dir : {1.0, -1.0})
                 {
-                  const Point pa = lerp(x[crossing[a][0]], x[crossing[a][1]], 0.5);
-                  const Point pb = lerp(x[crossing[b][0]], x[crossing[b][1]], 0.5);
-                  // The perpendicular bisector of the two points, in the
-                  // plane: the front separates them.
-                  const Point m = sub(pb, pa);
-                  const Point o = lerp(pa, pb, 0.5);
+                  // The perpendicular bisector of the two corners, in the plane.
+                  const Point m = sub(corners[b], corners[a]);
+                  const Point o = lerp(corners[a], corners[b], 0.5);
                   auto        c = plane_cut(
                     x, ids, s, p[0], n, true, o, {dir * m[0], dir * m[1], dir * m[2]});
-                  if (c.front_faces != 0)
+                  cut::SplitResult r;
+                  if (c.front_faces != 0
+                      && cut::split_tetrahedron(c, r) == cut::CutKind::partial)
                     inputs.push_back(c);
                 }
             break;
@@ -209,8 +218,9 @@ namespace lacerta::bench
             t = param(rng);
           inputs.push_back(c);
         }
-      } while (std::next_permutation(rank.begin(), rank.end()));
-      std::shuffle(inputs.begin(), inputs.end(), rng);
+      } while (every_order && std::next_permutation(rank.begin(), rank.end()));
+      if (every_order)
+        std::shuffle(inputs.begin(), inputs.end(), rng);
       return inputs;
     }
 
@@ -297,9 +307,49 @@ namespace lacerta::bench
       }
     }
 
+    // One split per case (the first input of each, in the identity vertex order): the
+    // parent, and every child's side, cut faces and node positions and kinds.
+    void
+    print_dump()
+    {
+      std::map<std::string, bool> done;
+      cut::SplitResult            r;
+      for (const auto &c : all_configurations(false))
+      {
+        cut::split_tetrahedron(c, r);
+        const auto &entry = cut::split_table_entries()[r.entry];
+        if (done[entry.name])
+          continue;
+        done[entry.name] = true;
+        std::printf("case %s %u\n", entry.name.c_str(), r.n_children);
+        for (const auto &p : c.points)
+          std::printf("parent %.6f %.6f %.6f\n", p[0], p[1], p[2]);
+        for (unsigned i = 0; i < r.n_children; ++i)
+        {
+          const cut::Child &child = r.children[i];
+          std::printf("child %d %u", child.side, child.cut_faces);
+          for (const auto &n : child.nodes)
+          {
+            const Point &p =
+              n.kind == cut::NodeKind::vertex       ? c.points[n.index]
+              : n.kind == cut::NodeKind::edge_point ? r.edge_points[n.index]
+              : n.kind == cut::NodeKind::face_point ? r.face_points[n.index]
+                                                    : r.interior_point;
+            std::printf(" %d %.6f %.6f %.6f", int(n.kind), p[0], p[1], p[2]);
+          }
+          std::printf("\n");
+        }
+      }
+    }
+
     int
     run_split_benchmark(const std::vector<std::string> &arguments)
     {
+      if (std::find(arguments.begin(), arguments.end(), "--dump") != arguments.end())
+      {
+        print_dump();
+        return 0;
+      }
       if (std::find(arguments.begin(), arguments.end(), "--table") != arguments.end())
       {
         print_table();

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <map>
+#include <numeric>
 #include <random>
 #include <set>
 #include <string>
@@ -404,6 +405,49 @@ TEST(CutSplitTable, DiagonalRuleIsThePapersAndSymmetric)
               quad_diagonal_through_first(p1, p0, z));
     EXPECT_EQ(diagonal_order_key(p0, z), diagonal_order_key(z, p0));
   } while (std::next_permutation(perm.begin(), perm.end()));
+}
+
+
+TEST(CutSplitTable, PapersRuleNeverTwistsTheCompleteCutPrisms)
+{
+  // The claim of doc/split-table.md: under the paper's rule (quad p0, p1, a, b split by
+  // p0-a iff p0 or b is the smallest) with any one total order of the points, the prism
+  // of case A never twists (all 720 orders of its six points), and the two prisms of
+  // case B never forbid both diagonals of the cut quadrilateral (all 40320 orders of
+  // its eight points). So no complete cut needs an interior vertex.
+  // The vertex of the quad p0, p1, a, b the rule's diagonal passes through:
+  const auto through =
+    [](const std::array<unsigned, 8> &r, unsigned p0, unsigned p1, unsigned a, unsigned b)
+  {
+    const unsigned m = std::min({r[p0], r[p1], r[a], r[b]});
+    return (m == r[p0] || m == r[b]) ? p0 : p1;
+  };
+  // Case A: apex 0, base 1, 2, 3; points 4, 5, 6 on the edges 0-1, 0-2, 0-3.
+  std::array<unsigned, 8> r{0, 1, 2, 3, 4, 5, 6, 7};
+  unsigned                orders = 0;
+  do
+  {
+    std::array<unsigned, 3> starts{}; // how many diagonals each base vertex starts
+    for (const auto &q : std::array<std::array<unsigned, 2>, 3>{{{1, 2}, {2, 3}, {3, 1}}})
+      ++starts[through(r, q[0], q[1], 3 + q[1], 3 + q[0]) - 1];
+    EXPECT_NE(starts, (std::array<unsigned, 3>{1, 1, 1})) << "twisted prism";
+    ++orders;
+  } while (std::next_permutation(r.begin(), r.begin() + 7));
+  EXPECT_EQ(orders, 5040u); // all orders of apex, base and cut points
+  // Case B: {0,1} | {2,3}; points 4 = q02, 5 = q03, 6 = q12, 7 = q13.
+  std::iota(r.begin(), r.end(), 0u);
+  do
+  {
+    const unsigned a1 = through(r, 0, 1, 6, 4),
+                   a2 = through(r, 0, 1, 7, 5); // faces 012, 013
+    const unsigned b1 = through(r, 2, 3, 5, 4),
+                   b2 = through(r, 2, 3, 7, 6); // faces 023, 123
+    // A prism twists with the cut diagonal q02-q13 if its face diagonals go 0 and 1
+    // (resp. 2 and 3), with q03-q12 if they go 1 and 0 (resp. 3 and 2).
+    const int forbidden_a = a1 == a2 ? 0 : (a1 == 0 ? 1 : 2);
+    const int forbidden_b = b1 == b2 ? 0 : (b1 == 2 ? 1 : 2);
+    EXPECT_FALSE(forbidden_a != 0 && forbidden_b != 0 && forbidden_a != forbidden_b);
+  } while (std::next_permutation(r.begin(), r.end()));
 }
 
 
