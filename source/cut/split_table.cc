@@ -20,17 +20,18 @@ namespace lacerta::cut
   namespace
   {
     // ---------------------------------------------------------------------------------
-    // Canonical node identifiers.
+    // Canonical node identifiers: 0-3 the vertices, 4+e and 10+e the two copies of the
+    // cut point of edge e (on the side of its first and of its second vertex; a
+    // refinement uses 4+e alone), 16+f the front point of face f, 20 the interior point.
     constexpr std::uint8_t
     first_copy(const unsigned e)
     {
-      return static_cast<std::uint8_t>(
-        4 + e); // copy on the side of the edge's first vertex
+      return static_cast<std::uint8_t>(4 + e);
     }
     constexpr std::uint8_t
     second_copy(const unsigned e)
     {
-      return static_cast<std::uint8_t>(10 + e); // copy on the side of its second vertex
+      return static_cast<std::uint8_t>(10 + e);
     }
     constexpr std::uint8_t
     face_node(const unsigned f)
