@@ -1149,6 +1149,9 @@ namespace lacerta::cut
   CutKind
   split_tetrahedron(const TetCut &cut, SplitResult &result, const double snap_fraction)
   {
+    if (!(snap_fraction > 0 && snap_fraction < 0.5))
+      throw std::invalid_argument(
+        "split_tetrahedron: the snap fraction must lie in (0, 0.5)");
     const Table &T   = table();
     const auto  &ids = cut.vertex_ids;
 

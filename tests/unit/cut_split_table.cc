@@ -13,6 +13,7 @@
 #include <numeric>
 #include <random>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -733,6 +734,26 @@ TEST(CutSplitTable, SnappingKeepsNewEdgesLong)
           << split_table_entries()[r.entry].name;
       }
   EXPECT_GT(snapped, 100u); // the planes near vertices did snap
+}
+
+
+TEST(CutSplitTable, RejectsBadInput)
+{
+  TetCut cut;
+  cut.vertex_ids = {1, 2, 3, 4};
+  cut.points     = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  cut.vertex_side.fill(1);
+  SplitResult r;
+  EXPECT_EQ(split_tetrahedron(cut, r), CutKind::none);
+  EXPECT_THROW(split_tetrahedron(cut, r, 0.5), std::invalid_argument);
+  EXPECT_THROW(split_tetrahedron(cut, r, 0.0), std::invalid_argument);
+  cut.vertex_ids = {1, 2, 2, 4};
+  EXPECT_THROW(split_tetrahedron(cut, r), std::invalid_argument);
+  // Front points that describe no partial cut: nothing is done.
+  cut.vertex_ids  = {1, 2, 3, 4};
+  cut.front_faces = 0b0001;
+  EXPECT_EQ(split_tetrahedron(cut, r), CutKind::unsupported);
+  EXPECT_EQ(r.n_children, 0u);
 }
 
 

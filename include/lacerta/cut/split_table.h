@@ -179,7 +179,8 @@ namespace lacerta::cut
    * face depends only on the data of that face (its three global ids, the cut points on
    * its edges and its front point), so face-adjacent tetrahedra produce the same
    * triangles. Works for either orientation of the parent. Thread-safe; the table is
-   * built on first use. Throws std::invalid_argument if two vertex ids are equal.
+   * built on first use. Throws std::invalid_argument if two vertex ids are equal or
+   * @p snap_fraction is not in (0, 0.5).
    *
    * @param snap_fraction ε, used to clamp edge parameters to [ε, 1-ε].
    */
