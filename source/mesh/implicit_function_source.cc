@@ -1,9 +1,11 @@
 // Mesh source `implicit function`: an organ-like shape {x : f(x) < 0} meshed by CGAL.
 
+#include <lacerta/base/exceptions.h>
 #include <lacerta/base/parameter_utilities.h>
 #include <lacerta/mesh/mesh_source.h>
 #include <lacerta/mesh/triangulation_conversion.h>
 
+#include <deal.II/base/exceptions.h>
 #include <deal.II/base/function_parser.h>
 #include <deal.II/cgal/additional_data.h>
 #include <deal.II/grid/grid_generator.h>
@@ -13,6 +15,22 @@ namespace lacerta::mesh
 {
   namespace
   {
+    /// The parser's own explanation from a deal.II exception, without the code location.
+    std::string
+    parser_message(const dealii::ExceptionBase &e)
+    {
+      std::ostringstream info;
+      e.print_info(info);
+      std::string text = info.str();
+      for (char &c : text)
+        if (c == '\n')
+          c = ' ';
+      while (!text.empty() && text.back() == ' ')
+        text.pop_back();
+      return text;
+    }
+
+
     /**
      * The volume where an implicit function is negative, meshed with tetrahedra by
      * CGAL's Mesh_3 through GridGenerator::implicit_function.
@@ -41,17 +59,17 @@ namespace lacerta::mesh
                           "Radius of a ball around the interior point that contains the "
                           "whole object [m].");
         prm.declare_entry("Cell size",
-                          "0.01",
+                          "0.005",
                           dealii::Patterns::Double(1e-9),
                           "Upper bound of the circumradius of the tetrahedra [m].");
         prm.declare_entry(
           "Facet size",
-          "0.01",
+          "0.005",
           dealii::Patterns::Double(1e-9),
           "Upper bound of the circumradius of the surface triangles [m].");
         prm.declare_entry(
           "Facet distance",
-          "0.002",
+          "0.0008",
           dealii::Patterns::Double(1e-12),
           "Upper bound of the distance between a surface triangle and the "
           "true surface [m].");
@@ -78,24 +96,29 @@ namespace lacerta::mesh
       TetMesh
       create_mesh() const override
       {
+        const dealii::Point<3>    inside(interior_point[0],
+                                      interior_point[1],
+                                      interior_point[2]);
         dealii::FunctionParser<3> function(1);
+        double                    f_inside = 0;
+        // deal.II 9.4 parses the expression on its first evaluation, not in
+        // initialize(): evaluate once here so that a syntax error becomes our message.
         try
         {
           function.initialize("x,y,z", expression, {});
+          f_inside = function.value(inside);
         }
-        catch (...)
+        catch (const dealii::ExceptionBase &e)
         {
-          throw_error("Mesh/Implicit function: cannot parse 'Function expression' = '",
+          throw_error("Mesh/Implicit function: cannot evaluate 'Function expression' = '",
                       expression,
-                      "'.");
+                      "': ",
+                      parser_message(e));
         }
-        const dealii::Point<3> inside(interior_point[0],
-                                      interior_point[1],
-                                      interior_point[2]);
-        if (!(function.value(inside) < 0))
+        if (!(f_inside < 0))
           throw_error(
             "Mesh/Implicit function: f is not negative at 'Interior point' (f = ",
-            function.value(inside),
+            f_inside,
             ").");
 
         dealii::CGALWrappers::AdditionalData<3> data;

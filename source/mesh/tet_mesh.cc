@@ -56,6 +56,40 @@ namespace lacerta::mesh
   } // namespace
 
 
+  std::string
+  degeneracy(const std::vector<Point3> &vertices, const Tet &cell)
+  {
+    std::ostringstream problem;
+    problem.precision(8);
+    for (unsigned int i = 0; i < 4; ++i)
+      for (unsigned int j = 0; j < i; ++j)
+        if (cell[i] == cell[j])
+        {
+          problem << "it repeats vertex " << cell[i] << " at "
+                  << describe_point(vertices[cell[i]]);
+          return problem.str();
+        }
+    const double volume = signed_volume(vertices[cell[0]],
+                                        vertices[cell[1]],
+                                        vertices[cell[2]],
+                                        vertices[cell[3]]);
+    const double h      = longest_edge(vertices, cell);
+    // A tetrahedron whose volume is negligible against the cube of its longest edge
+    // has no stiffness across its height and would make the time step collapse.
+    // (Also true when two distinct vertices share a position: then h may still be > 0
+    // but the volume is exactly zero.)
+    if (!(std::abs(volume) > 1e-12 * h * h * h))
+    {
+      problem << "its volume is zero (its vertices " << describe_point(vertices[cell[0]])
+              << ", " << describe_point(vertices[cell[1]]) << ", "
+              << describe_point(vertices[cell[2]]) << ", "
+              << describe_point(vertices[cell[3]]) << " lie in a plane)";
+      return problem.str();
+    }
+    return "";
+  }
+
+
   TetMesh::TetMesh(std::vector<Point3>         vertices_in,
                    std::vector<Tet>            tets_in,
                    const std::string          &source,
@@ -93,53 +127,30 @@ namespace lacerta::mesh
                       " but the mesh has only ",
                       vertices.size(),
                       " vertices.");
-        for (unsigned int j = 0; j < i; ++j)
-          if (cell[i] == cell[j])
-            throw_error("Mesh '",
-                        source_name,
-                        "': cell ",
-                        t,
-                        " is degenerate: it repeats vertex ",
-                        cell[i],
-                        " at ",
-                        describe_point(vertices[cell[i]]),
-                        ".");
       }
-      double       volume = signed_volume(vertices[cell[0]],
-                                    vertices[cell[1]],
-                                    vertices[cell[2]],
-                                    vertices[cell[3]]);
-      const double h      = longest_edge(vertices, cell);
-      // A tetrahedron whose volume is negligible against the cube of its longest edge
-      // has no stiffness across its height and would make the time step collapse.
-      if (std::abs(volume) <= 1e-12 * h * h * h)
-        throw_error("Mesh '",
-                    source_name,
-                    "': cell ",
-                    t,
-                    " is degenerate: its volume is zero (vertices ",
-                    cell[0],
-                    ", ",
-                    cell[1],
-                    ", ",
-                    cell[2],
-                    ", ",
-                    cell[3],
-                    " at ",
-                    describe_point(vertices[cell[0]]),
-                    ").");
+      const std::string problem = degeneracy(vertices, cell);
+      if (!problem.empty())
+        throw_error(
+          "Mesh '", source_name, "': cell ", t, " is degenerate: ", problem, ".");
+      const double volume = signed_volume(vertices[cell[0]],
+                                          vertices[cell[1]],
+                                          vertices[cell[2]],
+                                          vertices[cell[3]]);
       if (volume < 0)
         std::swap(cell[2], cell[3]);
     }
 
     // Vertices no tetrahedron uses (nodes of surface elements only, say) would be
-    // particles without mass: drop them.
+    // particles without mass: drop them. The others keep their order, so that vertex
+    // ids match the input's and the boundary tags below are renumbered like the tets.
     std::vector<unsigned int> compact(vertices.size(), invalid_index);
-    unsigned int              n_used = 0;
     for (const Tet &cell : tets)
       for (const unsigned int v : cell)
-        if (compact[v] == invalid_index)
-          compact[v] = n_used++;
+        compact[v] = 0;
+    unsigned int n_used = 0;
+    for (unsigned int &index : compact)
+      if (index != invalid_index)
+        index = n_used++;
     if (n_used < vertices.size())
     {
       std::vector<Point3> used(n_used);

@@ -1,34 +1,31 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/mesh/vtk_reader.h>
 
-#include <vtkCallbackCommand.h>
 #include <vtkCellData.h>
 #include <vtkCellType.h>
-#include <vtkCommand.h>
+#include <vtkCellTypes.h>
 #include <vtkDataArray.h>
 #include <vtkIdList.h>
+#include <vtkLogger.h>
 #include <vtkNew.h>
-#include <vtkPoints.h>
+#include <vtkOutputWindow.h>
+#include <vtkSmartPointer.h>
+#include <vtkStringOutputWindow.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkUnstructuredGridReader.h>
 #include <vtkXMLUnstructuredGridReader.h>
 
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
 #include <fstream>
+#include <sstream>
 
 namespace lacerta::mesh
 {
   namespace
   {
-    /// Collects the error messages VTK would otherwise print to its output window.
-    void
-    record_vtk_error(vtkObject *, unsigned long, void *client_data, void *call_data)
-    {
-      auto *messages = static_cast<std::string *>(client_data);
-      if (call_data != nullptr)
-        *messages += static_cast<const char *>(call_data);
-    }
-
-
     bool
     ends_with(const std::string &text, const std::string &suffix)
     {
@@ -37,44 +34,169 @@ namespace lacerta::mesh
     }
 
 
+    /**
+     * Routes VTK's messages into a string while it lives. VTK reports some problems
+     * (those of its XML parser, say) through the global output window rather than
+     * through the reader, and would print them to the terminal without failing.
+     */
+    class CapturedVtkMessages
+    {
+    public:
+      CapturedVtkMessages()
+          : previous(vtkOutputWindow::GetInstance())
+          , previous_verbosity(vtkLogger::GetCurrentVerbosityCutoff())
+      {
+        vtkOutputWindow::SetInstance(window);
+        // VTK's logger would print the same messages to the terminal as well.
+        vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
+      }
+
+      ~CapturedVtkMessages()
+      {
+        vtkOutputWindow::SetInstance(previous);
+        vtkLogger::SetStderrVerbosity(previous_verbosity);
+      }
+
+      CapturedVtkMessages(const CapturedVtkMessages &) = delete;
+      CapturedVtkMessages &
+      operator=(const CapturedVtkMessages &) = delete;
+
+      /**
+       * The messages so far if one of them is an error (else ""), without VTK's source
+       * locations and object addresses, which mean nothing to a user.
+       */
+      std::string
+      errors() const
+      {
+        const std::string text = window->GetOutput();
+        if (text.find("ERROR") == std::string::npos)
+          return "";
+        std::istringstream lines(text);
+        std::string        result;
+        for (std::string line; std::getline(lines, line);)
+        {
+          // Skip the source locations, and the pipeline's report that the reader
+          // failed with its indented dump of the request: the reader said why.
+          if (line.empty() || std::isspace(line[0])
+              || line.find(": In ") != std::string::npos
+              || line.find("returned failure for request") != std::string::npos)
+            continue;
+          const std::size_t address = line.find(" (0x");
+          const std::size_t close   = line.find("): ", address);
+          if (address != std::string::npos && close != std::string::npos)
+            line.erase(address, close + 1 - address);
+          result += (result.empty() ? "" : " ") + line;
+        }
+        return result;
+      }
+
+    private:
+      vtkSmartPointer<vtkOutputWindow> previous;
+      vtkLogger::Verbosity             previous_verbosity;
+      vtkNew<vtkStringOutputWindow>    window;
+    };
+
+
     /// Reads the file with the VTK reader that fits its extension.
     vtkSmartPointer<vtkUnstructuredGrid>
     read_grid(const std::string &file_name)
     {
-      std::string                errors;
-      vtkNew<vtkCallbackCommand> on_error;
-      on_error->SetCallback(record_vtk_error);
-      on_error->SetClientData(&errors);
+      const CapturedVtkMessages messages;
 
       vtkSmartPointer<vtkUnstructuredGrid> grid;
+      bool                                 failed = false;
       if (ends_with(file_name, ".vtu"))
       {
         vtkNew<vtkXMLUnstructuredGridReader> reader;
-        reader->AddObserver(vtkCommand::ErrorEvent, on_error);
+        if (!reader->CanReadFile(file_name.c_str()))
+          throw_error("Mesh file '",
+                      file_name,
+                      "' is not an XML VTK file holding an UnstructuredGrid.");
         reader->SetFileName(file_name.c_str());
         reader->Update();
-        grid = reader->GetOutput();
-        if (reader->GetErrorCode() != 0 && errors.empty())
-          errors = "the VTK reader reported an error";
+        grid   = reader->GetOutput();
+        failed = reader->GetErrorCode() != 0;
       }
       else
       {
         vtkNew<vtkUnstructuredGridReader> reader;
-        reader->AddObserver(vtkCommand::ErrorEvent, on_error);
         reader->SetFileName(file_name.c_str());
         if (!reader->IsFileUnstructuredGrid())
           throw_error("Mesh file '",
                       file_name,
                       "' is not a legacy VTK file holding an UNSTRUCTURED_GRID.");
         reader->Update();
-        grid = reader->GetOutput();
+        grid   = reader->GetOutput();
+        failed = reader->GetErrorCode() != 0;
       }
-      if (!errors.empty())
+      const std::string errors = messages.errors();
+      if (failed || !errors.empty())
         throw_error("Mesh file '",
                     file_name,
-                    "' could not be read (truncated or malformed?): ",
+                    "' could not be read (truncated or malformed?)",
+                    errors.empty() ? "." : ": ",
                     errors);
       return grid;
+    }
+
+
+    /**
+     * VTK's legacy reader stops at a coordinate written as `nan` or `inf` with
+     * "Unrecognized keyword", which names neither the point nor the line: look at the
+     * POINTS of an ASCII file first. Other problems are left to VTK.
+     */
+    void
+    check_legacy_points(const std::string &file_name)
+    {
+      std::ifstream in(file_name);
+      std::string   line;
+      std::size_t   line_number = 0;
+      for (; line_number < 3 && std::getline(in, line); ++line_number)
+        if (line_number == 2 && line.rfind("ASCII", 0) != 0)
+          return;
+      std::size_t n_points = 0;
+      while (n_points == 0 && std::getline(in, line))
+      {
+        ++line_number;
+        std::istringstream tokens(line);
+        std::string        keyword;
+        if (tokens >> keyword && keyword == "POINTS" && !(tokens >> n_points))
+          return;
+      }
+      std::size_t coordinate = 0;
+      while (coordinate < 3 * n_points && std::getline(in, line))
+      {
+        ++line_number;
+        std::istringstream tokens(line);
+        for (std::string token; coordinate < 3 * n_points && tokens >> token;
+             ++coordinate)
+        {
+          char        *rest = nullptr;
+          const double x    = std::strtod(token.c_str(), &rest);
+          if (rest == token.c_str() || *rest != '\0' || !std::isfinite(x))
+            throw_error("Mesh file '",
+                        file_name,
+                        "', line ",
+                        line_number,
+                        ": point ",
+                        coordinate / 3,
+                        " has a coordinate that is not a finite number ('",
+                        token,
+                        "').");
+        }
+      }
+    }
+
+
+    /// "hexahedron" for VTK_HEXAHEDRON: VTK's class name without its prefix.
+    std::string
+    cell_type_name(const int type)
+    {
+      std::string name = vtkCellTypes::GetClassNameFromTypeId(type);
+      if (name.rfind("vtk", 0) == 0)
+        name = name.substr(3);
+      std::transform(name.begin(), name.end(), name.begin(), ::tolower);
+      return name;
     }
   } // namespace
 
@@ -84,6 +206,8 @@ namespace lacerta::mesh
   {
     if (!std::ifstream(file_name))
       throw_error("Mesh file '", file_name, "' cannot be opened.");
+    if (!ends_with(file_name, ".vtu"))
+      check_legacy_points(file_name);
 
     const vtkSmartPointer<vtkUnstructuredGrid> grid = read_grid(file_name);
     if (grid == nullptr || grid->GetNumberOfPoints() == 0)
@@ -91,7 +215,22 @@ namespace lacerta::mesh
 
     std::vector<Point3> vertices(grid->GetNumberOfPoints());
     for (vtkIdType i = 0; i < grid->GetNumberOfPoints(); ++i)
+    {
       grid->GetPoint(i, vertices[i].data());
+      for (const double x : vertices[i])
+        if (!std::isfinite(x))
+          throw_error("Mesh file '",
+                      file_name,
+                      "': point ",
+                      i,
+                      " has a coordinate that is not a finite number (",
+                      vertices[i][0],
+                      ", ",
+                      vertices[i][1],
+                      ", ",
+                      vertices[i][2],
+                      ").");
+    }
 
     vtkDataArray *ids = grid->GetCellData()->GetArray("boundary_id");
     if (ids == nullptr)
@@ -114,17 +253,42 @@ namespace lacerta::mesh
                       points->GetId(i),
                       ", which does not exist (truncated file?).");
       if (type == VTK_TETRA)
-        tets.push_back({static_cast<unsigned int>(points->GetId(0)),
-                        static_cast<unsigned int>(points->GetId(1)),
-                        static_cast<unsigned int>(points->GetId(2)),
-                        static_cast<unsigned int>(points->GetId(3))});
+      {
+        const Tet cell = {static_cast<unsigned int>(points->GetId(0)),
+                          static_cast<unsigned int>(points->GetId(1)),
+                          static_cast<unsigned int>(points->GetId(2)),
+                          static_cast<unsigned int>(points->GetId(3))};
+        // Checked here, not only in TetMesh, so that the message counts cells as the
+        // file does (triangles included).
+        const std::string problem = degeneracy(vertices, cell);
+        if (!problem.empty())
+          throw_error("Mesh file '",
+                      file_name,
+                      "': cell ",
+                      c,
+                      " (tetrahedron) is degenerate: ",
+                      problem,
+                      ".");
+        tets.push_back(cell);
+      }
       else if (type == VTK_TRIANGLE)
       {
         if (ids != nullptr)
+        {
+          const double id = ids->GetTuple1(c);
+          if (!(id >= 0 && id < 1e9 && id == std::floor(id)))
+            throw_error("Mesh file '",
+                        file_name,
+                        "': cell ",
+                        c,
+                        " (triangle) has the boundary id ",
+                        id,
+                        ", which is not a non-negative integer.");
           tags.push_back({{static_cast<unsigned int>(points->GetId(0)),
                            static_cast<unsigned int>(points->GetId(1)),
                            static_cast<unsigned int>(points->GetId(2))},
-                          static_cast<unsigned int>(ids->GetTuple1(c))});
+                          static_cast<unsigned int>(id)});
+        }
       }
       else if (type != VTK_VERTEX && type != VTK_POLY_VERTEX && type != VTK_LINE
                && type != VTK_POLY_LINE)
@@ -132,10 +296,14 @@ namespace lacerta::mesh
                     file_name,
                     "': cell ",
                     c,
-                    " has VTK cell type ",
+                    " is a ",
+                    cell_type_name(type),
+                    " (VTK cell type ",
                     type,
-                    ", not a tetrahedron (10); Lacerta needs a mesh of tetrahedra.");
+                    "), not a tetrahedron (10); Lacerta needs a mesh of tetrahedra.");
     }
+    if (tets.empty())
+      throw_error("Mesh file '", file_name, "' has no tetrahedra.");
     return TetMesh(std::move(vertices), std::move(tets), file_name, tags);
   }
 } // namespace lacerta::mesh

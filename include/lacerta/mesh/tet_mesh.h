@@ -209,4 +209,15 @@ namespace lacerta::mesh
    */
   double
   signed_volume(const Point3 &a, const Point3 &b, const Point3 &c, const Point3 &d);
+
+  /**
+   * Why the tetrahedron @p cell of @p vertices cannot be used, or an empty string if it
+   * can: it repeats a vertex, or its volume is (near) zero against the cube of its
+   * longest edge. A repeated vertex is named by its id in @p cell, a flat tetrahedron by
+   * the coordinates of its vertices. Readers call this before
+   * building a TetMesh so that their messages can name the cell as the file numbers it.
+   * The ids in @p cell must be valid indices into @p vertices.
+   */
+  std::string
+  degeneracy(const std::vector<Point3> &vertices, const Tet &cell);
 } // namespace lacerta::mesh

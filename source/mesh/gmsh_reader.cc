@@ -1,0 +1,518 @@
+// gmsh .msh files: a strict check of our own (deal.II's GridIn names neither the line
+// nor the element of a problem, and some bad elements reach assertions there), then
+// GridIn reads the file that passed.
+
+#include <lacerta/base/exceptions.h>
+#include <lacerta/mesh/gmsh_reader.h>
+#include <lacerta/mesh/triangulation_conversion.h>
+
+#include <deal.II/base/exceptions.h>
+#include <deal.II/grid/grid_in.h>
+#include <deal.II/grid/tria.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <unordered_map>
+
+namespace lacerta::mesh
+{
+  namespace
+  {
+    /// Name and number of nodes of the gmsh element types 1 to 19 (index = type).
+    struct ElementType
+    {
+      const char  *name;
+      unsigned int n_nodes;
+      unsigned int dim;
+    };
+    constexpr ElementType  element_types[] = {{"", 0, 0},
+                                              {"line", 2, 1},
+                                              {"triangle", 3, 2},
+                                              {"quadrangle", 4, 2},
+                                              {"tetrahedron", 4, 3},
+                                              {"hexahedron", 8, 3},
+                                              {"prism", 6, 3},
+                                              {"pyramid", 5, 3},
+                                              {"second-order line", 3, 1},
+                                              {"second-order triangle", 6, 2},
+                                              {"second-order quadrangle", 9, 2},
+                                              {"second-order tetrahedron", 10, 3},
+                                              {"second-order hexahedron", 27, 3},
+                                              {"second-order prism", 18, 3},
+                                              {"second-order pyramid", 14, 3},
+                                              {"point", 1, 0},
+                                              {"8-node quadrangle", 8, 2},
+                                              {"20-node hexahedron", 20, 3},
+                                              {"15-node prism", 15, 3},
+                                              {"13-node pyramid", 13, 3}};
+    constexpr unsigned int gmsh_line = 1, gmsh_triangle = 2, gmsh_tetrahedron = 4,
+                           gmsh_point = 15;
+
+
+    /**
+     * Reads the whitespace-separated tokens of one section of the file and knows the
+     * line each came from, so that every message can name it.
+     */
+    class SectionReader
+    {
+    public:
+      SectionReader(const std::string              &file_name,
+                    const std::vector<std::string> &lines,
+                    const std::string              &section,
+                    const std::size_t               begin,
+                    const std::size_t               end)
+          : file_name(file_name)
+          , lines(lines)
+          , section(section)
+          , current(begin)
+          , end(end)
+      {
+      }
+
+      /// The 1-based line of the last token read.
+      std::size_t
+      line() const
+      {
+        return current + 1;
+      }
+
+      /// The next token; a section that ends first is a truncated or malformed file.
+      std::string
+      token(const char *what)
+      {
+        while (current < end)
+        {
+          const std::string &text = lines[current];
+          while (position < text.size() && std::isspace(text[position]))
+            ++position;
+          if (position < text.size())
+          {
+            const std::size_t start = position;
+            while (position < text.size() && !std::isspace(text[position]))
+              ++position;
+            return text.substr(start, position - start);
+          }
+          ++current;
+          position = 0;
+        }
+        throw_error("Mesh file '",
+                    file_name,
+                    "', line ",
+                    end + 1,
+                    ": section $",
+                    section,
+                    " ends where ",
+                    what,
+                    " was expected; the file is truncated or malformed.");
+      }
+
+      /// The next token as a non-negative integer.
+      std::size_t
+      integer(const char *what)
+      {
+        const std::string text = token(what);
+        char             *rest = nullptr;
+        const long long   n    = std::strtoll(text.c_str(), &rest, 10);
+        if (rest == text.c_str() || *rest != '\0' || n < 0)
+          fail("expected ", what, " (a non-negative integer), found '", text, "'");
+        return static_cast<std::size_t>(n);
+      }
+
+      /// The next token as a floating-point number (which may be NaN or infinite).
+      double
+      number(const char *what)
+      {
+        const std::string text = token(what);
+        char             *rest = nullptr;
+        const double      x    = std::strtod(text.c_str(), &rest);
+        if (rest == text.c_str() || *rest != '\0')
+          fail("expected ", what, " (a number), found '", text, "'");
+        return x;
+      }
+
+      /// Checks that nothing but whitespace is left in the section.
+      void
+      expect_end(const char *after)
+      {
+        for (; current < end; ++current, position = 0)
+        {
+          const std::string &text = lines[current];
+          const std::size_t  next = text.find_first_not_of(" \t", position);
+          if (next != std::string::npos)
+            throw_error("Mesh file '",
+                        file_name,
+                        "', line ",
+                        current + 1,
+                        ": unexpected '",
+                        text.substr(next),
+                        "' after ",
+                        after,
+                        " in section $",
+                        section,
+                        " (the counts in the section do not match its contents).");
+        }
+      }
+
+      /// Throws an Error naming the file and the current line.
+      template <typename... Args>
+      [[noreturn]] void
+      fail(const Args &...pieces) const
+      {
+        throw_error("Mesh file '", file_name, "', line ", line(), ": ", pieces..., ".");
+      }
+
+    private:
+      const std::string              &file_name;
+      const std::vector<std::string> &lines;
+      const std::string               section;
+      std::size_t                     current;
+      std::size_t                     position = 0;
+      const std::size_t               end;
+    };
+
+
+    /// An element as the file gives it.
+    struct Element
+    {
+      std::size_t              tag;
+      unsigned int             type;
+      std::vector<std::size_t> nodes;
+      std::size_t              line;
+    };
+
+
+    /// Reads one element's type-dependent node list after its tag and type.
+    Element
+    read_element(SectionReader &in, const std::size_t tag, const std::size_t type)
+    {
+      const std::size_t n_types = sizeof(element_types) / sizeof(element_types[0]);
+      if (type == 0 || type >= n_types)
+        in.fail("element ", tag, " has type ", type, ", which Lacerta does not know");
+      Element element{tag, static_cast<unsigned int>(type), {}, in.line()};
+      element.nodes.resize(element_types[type].n_nodes);
+      for (std::size_t &node : element.nodes)
+        node = in.integer("a node tag");
+      return element;
+    }
+  } // namespace
+
+
+  void
+  check_gmsh_file(const std::string &file_name)
+  {
+    std::ifstream file(file_name);
+    if (!file)
+      throw_error("Mesh file '", file_name, "' cannot be opened.");
+
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(file, line);)
+    {
+      if (!line.empty() && line.back() == '\r')
+        line.pop_back();
+      lines.push_back(line);
+    }
+    if (lines.empty() || lines[0] != "$MeshFormat")
+      throw_error("Mesh file '",
+                  file_name,
+                  "' is not a gmsh file: it does not start with $MeshFormat.");
+
+    // Sections: [first line of the body, line of $End...) for every name.
+    std::map<std::string, std::pair<std::size_t, std::size_t>> sections;
+    std::string                                                open_section;
+    std::size_t                                                open_line = 0;
+    for (std::size_t i = 0; i < lines.size(); ++i)
+    {
+      const std::string &line = lines[i];
+      if (line.empty() || line[0] != '$')
+        continue;
+      if (open_section.empty())
+      {
+        open_section = line.substr(1);
+        open_line    = i;
+      }
+      else if (line == "$End" + open_section)
+      {
+        sections[open_section] = {open_line + 1, i};
+        open_section.clear();
+      }
+      else
+        throw_error("Mesh file '",
+                    file_name,
+                    "', line ",
+                    i + 1,
+                    ": found '",
+                    line,
+                    "' inside section $",
+                    open_section,
+                    " (opened on line ",
+                    open_line + 1,
+                    "); the file is truncated or malformed.");
+    }
+    if (!open_section.empty())
+      throw_error("Mesh file '",
+                  file_name,
+                  "' is truncated: section $",
+                  open_section,
+                  " (opened on line ",
+                  open_line + 1,
+                  ") has no $End",
+                  open_section,
+                  " before the end of the file at line ",
+                  lines.size(),
+                  ".");
+    for (const char *required : {"MeshFormat", "Nodes", "Elements"})
+      if (sections.count(required) == 0)
+        throw_error("Mesh file '",
+                    file_name,
+                    "' is truncated or incomplete: it has no $",
+                    required,
+                    " section.");
+
+    const auto reader = [&](const std::string &name)
+    {
+      return SectionReader(
+        file_name, lines, name, sections[name].first, sections[name].second);
+    };
+
+    SectionReader     format       = reader("MeshFormat");
+    const std::string version_text = format.token("the format version");
+    const double      version      = std::strtod(version_text.c_str(), nullptr);
+    const std::size_t file_type    = format.integer("the file type");
+    const bool        v2           = version >= 2 && version < 3;
+    const bool        v41          = version >= 4.1 && version < 5;
+    if (!v2 && !v41)
+      format.fail("gmsh format version '",
+                  version_text,
+                  "' is not supported (Lacerta reads ASCII formats 2.2 and 4.1)");
+    if (file_type != 0)
+      format.fail("this is a binary gmsh file; save it as ASCII");
+
+    // Nodes: tag -> index into coordinates.
+    std::unordered_map<std::size_t, unsigned int> node_index;
+    std::vector<Point3>                           coordinates;
+    std::vector<std::size_t>                      node_tag;
+    SectionReader                                 nodes = reader("Nodes");
+    const auto add_node = [&](const std::size_t tag, const Point3 &x)
+    {
+      for (const double xi : x)
+        if (!std::isfinite(xi))
+          nodes.fail("node ",
+                     tag,
+                     " has a coordinate that is not a finite number (",
+                     x[0],
+                     ", ",
+                     x[1],
+                     ", ",
+                     x[2],
+                     ")");
+      if (!node_index.emplace(tag, coordinates.size()).second)
+        nodes.fail("node ", tag, " is defined twice");
+      coordinates.push_back(x);
+      node_tag.push_back(tag);
+    };
+    if (v2)
+    {
+      const std::size_t n = nodes.integer("the number of nodes");
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        const std::size_t tag = nodes.integer("a node tag");
+        Point3            x;
+        for (double &xi : x)
+          xi = nodes.number("the node coordinate");
+        add_node(tag, x);
+      }
+    }
+    else
+    {
+      const std::size_t n_blocks = nodes.integer("the number of node blocks");
+      nodes.integer("the number of nodes");
+      nodes.integer("the smallest node tag");
+      nodes.integer("the largest node tag");
+      for (std::size_t b = 0; b < n_blocks; ++b)
+      {
+        nodes.integer("the entity dimension");
+        nodes.integer("the entity tag");
+        const std::size_t        parametric = nodes.integer("the parametric flag");
+        const std::size_t        n = nodes.integer("the number of nodes in the block");
+        std::vector<std::size_t> tags(n);
+        for (std::size_t &tag : tags)
+          tag = nodes.integer("a node tag");
+        for (const std::size_t tag : tags)
+        {
+          Point3 x;
+          for (double &xi : x)
+            xi = nodes.number("the node coordinate");
+          if (parametric != 0)
+            nodes.fail("node ", tag, " has parametric coordinates; save without them");
+          add_node(tag, x);
+        }
+      }
+    }
+
+    nodes.expect_end("the last node");
+
+    // Elements, with the line each starts on.
+    std::vector<Element> elements;
+    SectionReader        element_reader = reader("Elements");
+    if (v2)
+    {
+      const std::size_t n = element_reader.integer("the number of elements");
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        const std::size_t tag    = element_reader.integer("an element tag");
+        const std::size_t type   = element_reader.integer("the element type");
+        const std::size_t n_tags = element_reader.integer("the number of element tags");
+        for (std::size_t t = 0; t < n_tags; ++t)
+          element_reader.integer("an element tag (physical, elementary, partition)");
+        elements.push_back(read_element(element_reader, tag, type));
+      }
+    }
+    else
+    {
+      const std::size_t n_blocks = element_reader.integer("the number of element blocks");
+      element_reader.integer("the number of elements");
+      element_reader.integer("the smallest element tag");
+      element_reader.integer("the largest element tag");
+      for (std::size_t b = 0; b < n_blocks; ++b)
+      {
+        element_reader.integer("the entity dimension");
+        element_reader.integer("the entity tag");
+        const std::size_t type = element_reader.integer("the element type");
+        const std::size_t n =
+          element_reader.integer("the number of elements in the block");
+        for (std::size_t i = 0; i < n; ++i)
+        {
+          const std::size_t tag = element_reader.integer("an element tag");
+          elements.push_back(read_element(element_reader, tag, type));
+        }
+      }
+    }
+
+    element_reader.expect_end("the last element");
+
+    // Every element: known kind, defined nodes; tetrahedra must not be degenerate.
+    std::map<std::array<unsigned int, 3>, unsigned int>                  face_count;
+    std::vector<std::pair<std::array<unsigned int, 3>, const Element *>> triangles;
+    std::size_t                                                          n_tets = 0;
+    for (const Element &element : elements)
+    {
+      const auto fail = [&](const auto &...pieces)
+      {
+        throw_error("Mesh file '",
+                    file_name,
+                    "', line ",
+                    element.line,
+                    ": element ",
+                    element.tag,
+                    " (",
+                    element_types[element.type].name,
+                    ") ",
+                    pieces...,
+                    ".");
+      };
+      std::vector<unsigned int> ids;
+      for (const std::size_t node : element.nodes)
+      {
+        const auto found = node_index.find(node);
+        if (found == node_index.end())
+          fail("refers to node ", node, ", which $Nodes does not define");
+        ids.push_back(found->second);
+      }
+      switch (element.type)
+      {
+        case gmsh_point:
+        case gmsh_line:
+          break;
+        case gmsh_triangle:
+        {
+          std::array<unsigned int, 3> key = {ids[0], ids[1], ids[2]};
+          std::sort(key.begin(), key.end());
+          if (key[0] == key[1] || key[1] == key[2])
+            fail("is degenerate: it repeats node ",
+                 element.nodes[key[0] == key[1] ? 0 : 2]);
+          triangles.emplace_back(key, &element);
+          break;
+        }
+        case gmsh_tetrahedron:
+        {
+          for (unsigned int i = 0; i < 4; ++i)
+            for (unsigned int j = 0; j < i; ++j)
+              if (ids[i] == ids[j])
+                fail("is degenerate: it repeats node ", element.nodes[i]);
+          const Tet         cell    = {ids[0], ids[1], ids[2], ids[3]};
+          const std::string problem = degeneracy(coordinates, cell);
+          if (!problem.empty())
+            fail("is degenerate: ", problem);
+          for (const auto &f : TetMesh::face_vertices)
+          {
+            std::array<unsigned int, 3> key = {cell[f[0]], cell[f[1]], cell[f[2]]};
+            std::sort(key.begin(), key.end());
+            ++face_count[key];
+          }
+          ++n_tets;
+          break;
+        }
+        default:
+          fail("is not a tetrahedron; Lacerta needs a mesh of tetrahedra (triangles, "
+               "lines and points may describe its boundary)");
+      }
+    }
+    if (n_tets == 0)
+      throw_error("Mesh file '", file_name, "' has no tetrahedra.");
+    for (const auto &[key, count] : face_count)
+      if (count > 2)
+        throw_error("Mesh file '",
+                    file_name,
+                    "' is not a manifold: the face with nodes ",
+                    node_tag[key[0]],
+                    ", ",
+                    node_tag[key[1]],
+                    ", ",
+                    node_tag[key[2]],
+                    " is shared by ",
+                    count,
+                    " tetrahedra.");
+    // A triangle gives a boundary id; one that is no boundary face of a tetrahedron
+    // cannot carry one.
+    for (const auto &[key, element] : triangles)
+    {
+      const auto found = face_count.find(key);
+      if (found == face_count.end() || found->second != 1)
+        throw_error("Mesh file '",
+                    file_name,
+                    "', line ",
+                    element->line,
+                    ": element ",
+                    element->tag,
+                    " (triangle) is not a boundary face of the tetrahedra",
+                    found == face_count.end() ? "" : " (it lies inside the mesh)",
+                    "; surface elements only give boundary ids.");
+    }
+  }
+
+
+  TetMesh
+  read_gmsh(const std::string &file_name)
+  {
+    check_gmsh_file(file_name);
+    dealii::Triangulation<3> triangulation;
+    dealii::GridIn<3>        grid_in;
+    grid_in.attach_triangulation(triangulation);
+    std::ifstream in(file_name);
+    try
+    {
+      grid_in.read_msh(in);
+    }
+    catch (const dealii::ExceptionBase &e)
+    {
+      std::ostringstream info;
+      e.print_info(info);
+      throw_error(
+        "Mesh file '", file_name, "' could not be read by deal.II: ", info.str());
+    }
+    return tet_mesh_from_triangulation(triangulation, file_name);
+  }
+} // namespace lacerta::mesh

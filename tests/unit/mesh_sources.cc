@@ -1,0 +1,254 @@
+// Mesh sources on real files: gmsh 2.2 and 4.1, VTK legacy and XML, the implicit
+// function; and the refusal of bad files with a message naming the file and the cell.
+
+#include <lacerta/base/exceptions.h>
+#include <lacerta/mesh/mesh_source.h>
+#include <lacerta/mesh/vtk_reader.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+
+using namespace lacerta;
+using namespace lacerta::mesh;
+
+namespace
+{
+  const std::string data_dir = LACERTA_TEST_DATA_DIR;
+
+  /// Creates a mesh source by name through the parameter file machinery, as a scene does.
+  TetMesh
+  mesh_from_source(const std::string                        &source,
+                   const std::map<std::string, std::string> &entries)
+  {
+    dealii::ParameterHandler prm;
+    MeshSource::declare_parameters(prm);
+    prm.enter_subsection("Mesh");
+    prm.set("Source", source);
+    std::string subsection = source;
+    subsection[0]          = static_cast<char>(std::toupper(subsection[0]));
+    prm.enter_subsection(subsection);
+    for (const auto &[name, value] : entries)
+      prm.set(name, value);
+    prm.leave_subsection();
+    prm.leave_subsection();
+    return MeshSource::create(prm)->create_mesh();
+  }
+
+
+  TetMesh
+  mesh_from_file(const std::string &name)
+  {
+    return mesh_from_source("file", {{"File name", data_dir + "/" + name}});
+  }
+
+
+  /**
+   * The unit cube of tests/data: six tetrahedra around the diagonal (0,0,0)-(1,1,1),
+   * three of them given inverted; the faces at x = 0 carry boundary id 1, those at
+   * x = 1 id 2, the rest none (0).
+   */
+  void
+  expect_tagged_unit_cube(const TetMesh &mesh)
+  {
+    EXPECT_EQ(mesh.n_tets(), 6u);
+    EXPECT_EQ(mesh.n_vertices(), 8u);
+    EXPECT_EQ(mesh.n_edges(), 19u); // 12 cube edges, 6 face diagonals, 1 body diagonal
+    EXPECT_NEAR(mesh.total_volume(), 1.0, 1e-14);
+    for (unsigned int t = 0; t < mesh.n_tets(); ++t)
+      EXPECT_NEAR(mesh.volume(t), 1.0 / 6, 1e-14) << "tet " << t;
+
+    ASSERT_EQ(mesh.get_boundary_faces().size(), 12u);
+    std::map<unsigned int, unsigned int> faces_with_id;
+    for (const BoundaryFace &bf : mesh.get_boundary_faces())
+    {
+      ++faces_with_id[bf.boundary_id];
+      const Tet &t = mesh.tet(bf.tet);
+      for (const unsigned int lv : TetMesh::face_vertices[bf.face])
+      {
+        const double x = mesh.vertex(t[lv])[0];
+        if (bf.boundary_id == 1)
+        {
+          EXPECT_EQ(x, 0.0);
+        }
+        else if (bf.boundary_id == 2)
+        {
+          EXPECT_EQ(x, 1.0);
+        }
+      }
+    }
+    EXPECT_EQ(faces_with_id[0], 8u);
+    EXPECT_EQ(faces_with_id[1], 2u);
+    EXPECT_EQ(faces_with_id[2], 2u);
+  }
+
+
+  /// The message of the Error that reading @p name throws ("" if none is thrown).
+  std::string
+  refusal(const std::string &name)
+  {
+    try
+    {
+      mesh_from_file(name);
+    }
+    catch (const Error &e)
+    {
+      return e.what();
+    }
+    return "";
+  }
+} // namespace
+
+
+TEST(MeshSources, GmshVersion2)
+{
+  expect_tagged_unit_cube(mesh_from_file("cube_v2.msh"));
+}
+
+
+TEST(MeshSources, GmshVersion4)
+{
+  expect_tagged_unit_cube(mesh_from_file("cube_v4.msh"));
+}
+
+
+TEST(MeshSources, VtkLegacy)
+{
+  expect_tagged_unit_cube(mesh_from_file("cube.vtk"));
+}
+
+
+TEST(MeshSources, VtkXml)
+{
+  expect_tagged_unit_cube(read_vtk_unstructured_grid(data_dir + "/cube.vtu"));
+}
+
+
+TEST(MeshSources, AllFormatsGiveTheSameMesh)
+{
+  // The same edges, compared by the positions of their ends: the readers need not
+  // number the vertices alike.
+  const auto edges_by_position = [](const TetMesh &mesh)
+  {
+    std::set<std::pair<Point3, Point3>> edges;
+    for (const auto &e : mesh.get_edges())
+      edges.insert(std::minmax(mesh.vertex(e[0]), mesh.vertex(e[1])));
+    return edges;
+  };
+  const auto reference = edges_by_position(mesh_from_file("cube_v2.msh"));
+  EXPECT_EQ(reference.size(), 19u);
+  for (const char *name : {"cube_v4.msh", "cube.vtk", "cube.vtu"})
+    EXPECT_EQ(edges_by_position(mesh_from_file(name)), reference) << name;
+}
+
+
+TEST(MeshSources, ImplicitFunctionDefaultIsAValidOrgan)
+{
+  const auto    start = std::chrono::steady_clock::now();
+  const TetMesh mesh  = mesh_from_source("implicit function", {});
+  const double  seconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The defaults aim at a few thousand tetrahedra in well under a second (0.1 s on
+  // the development machine); the bound leaves room for a slow test machine.
+  EXPECT_LT(seconds, 5.0);
+  EXPECT_GE(mesh.n_tets(), 2000u);
+  EXPECT_LE(mesh.n_tets(), 10000u);
+  double smallest = 1e300;
+  for (unsigned int t = 0; t < mesh.n_tets(); ++t)
+    smallest = std::min(smallest, mesh.volume(t));
+  EXPECT_GT(smallest, 0.0);
+  // The default shape is an ellipsoid with semi-axes 5, 3 and 2.5 cm and a dent: its
+  // volume is somewhat below the ellipsoid's, 4/3 pi abc = 1.5708e-4 m^3.
+  const double ellipsoid = 4.0 / 3 * M_PI * 0.05 * 0.03 * 0.025;
+  EXPECT_LT(mesh.total_volume(), ellipsoid);
+  EXPECT_GT(mesh.total_volume(), 0.6 * ellipsoid);
+  // A closed surface: every boundary vertex lies on f = 0 within the facet distance,
+  // so nothing of the object sticks out of the bounding box of the ellipsoid.
+  for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
+  {
+    EXPECT_LE(std::abs(mesh.vertex(v)[0]), 0.05 * 1.05);
+    EXPECT_LE(std::abs(mesh.vertex(v)[1]), 0.03 * 1.05);
+    EXPECT_LE(std::abs(mesh.vertex(v)[2]), 0.025 * 1.05);
+  }
+}
+
+
+TEST(MeshSources, ImplicitFunctionBadExpressionIsRefused)
+{
+  try
+  {
+    mesh_from_source("implicit function", {{"Function expression", "x^2 + sin("}});
+    FAIL() << "a bad expression was accepted";
+  }
+  catch (const Error &e)
+  {
+    EXPECT_NE(std::string(e.what()).find("Function expression"), std::string::npos)
+      << e.what();
+  }
+}
+
+
+/// A bad file and what its refusal must name besides the file.
+struct BadFile
+{
+  const char *file;
+  const char *where;
+};
+
+
+class MeshRefusal : public testing::TestWithParam<BadFile>
+{
+};
+
+
+TEST_P(MeshRefusal, NamesTheFileAndTheCell)
+{
+  const std::string message = refusal(GetParam().file);
+  ASSERT_FALSE(message.empty()) << GetParam().file << " was accepted";
+  EXPECT_NE(message.find(data_dir + "/" + GetParam().file), std::string::npos) << message;
+  EXPECT_NE(message.find(GetParam().where), std::string::npos) << message;
+}
+
+
+INSTANTIATE_TEST_SUITE_P(
+  MeshSources,
+  MeshRefusal,
+  testing::Values(
+    BadFile{"bad_repeated_vertex.msh",
+            "line 32: element 10 (tetrahedron) is degenerate: it repeats node 5"},
+    BadFile{"bad_zero_volume.msh",
+            "line 32: element 10 (tetrahedron) is degenerate: its volume is zero"},
+    BadFile{"bad_hexahedron.msh", "element 11 (hexahedron) is not a tetrahedron"},
+    BadFile{"bad_hexahedron_v4.msh", "element 11 (hexahedron) is not a tetrahedron"},
+    BadFile{"bad_nan.msh", "line 18: node 7 has a coordinate that is not a finite"},
+    BadFile{"bad_truncated.msh", "is truncated: section $Elements"},
+    BadFile{"bad_truncated_v4.msh", "is truncated: section $Nodes"},
+    BadFile{"bad_repeated_vertex.vtk", "cell 9 (tetrahedron) is degenerate: it repeats"},
+    BadFile{"bad_zero_volume.vtk", "cell 9 (tetrahedron) is degenerate: its volume"},
+    BadFile{"bad_hexahedron.vtk", "cell 10 is a hexahedron"},
+    BadFile{"bad_nan.vtk", "line 12: point 6 has a coordinate that is not a finite"},
+    BadFile{"bad_truncated.vtk", "could not be read (truncated or malformed?): "},
+    BadFile{"bad_repeated_vertex.vtu", "cell 9 (tetrahedron) is degenerate: it repeats"},
+    BadFile{"bad_zero_volume.vtu", "cell 9 (tetrahedron) is degenerate: its volume"},
+    BadFile{"bad_hexahedron.vtu", "cell 10 is a hexahedron"},
+    BadFile{"bad_nan.vtu", "point 6 has a coordinate that is not a finite"},
+    BadFile{"bad_truncated.vtu", "could not be read (truncated or malformed?): "},
+    BadFile{"bad_missing_node.msh",
+            "line 32: element 10 (tetrahedron) refers to node 9, which $Nodes does not"},
+    BadFile{"bad_interior_triangle.msh",
+            "line 26: element 4 (triangle) is not a boundary face of the tetrahedra (it "
+            "lies inside the mesh)"},
+    BadFile{"does_not_exist.msh", "cannot be opened"}),
+  [](const testing::TestParamInfo<BadFile> &info)
+  {
+    std::string name = info.param.file;
+    for (char &c : name)
+      if (!std::isalnum(c))
+        c = '_';
+    return name;
+  });
