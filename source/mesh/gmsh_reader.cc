@@ -16,6 +16,7 @@
 #include <fstream>
 #include <map>
 #include <unordered_map>
+#include <utility>
 
 namespace lacerta::mesh
 {
@@ -394,7 +395,9 @@ namespace lacerta::mesh
     element_reader.expect_end("the last element");
 
     // Every element: known kind, defined nodes; tetrahedra must not be degenerate.
-    std::map<std::array<unsigned int, 3>, unsigned int>                  face_count;
+    // Faces of all tetrahedra as sorted node triples (a sorted vector: a map costs
+    // more than the rest of the check on large meshes).
+    std::vector<std::array<unsigned int, 3>>                             faces;
     std::vector<std::pair<std::array<unsigned int, 3>, const Element *>> triangles;
     std::size_t                                                          n_tets = 0;
     for (const Element &element : elements)
@@ -450,7 +453,7 @@ namespace lacerta::mesh
           {
             std::array<unsigned int, 3> key = {cell[f[0]], cell[f[1]], cell[f[2]]};
             std::sort(key.begin(), key.end());
-            ++face_count[key];
+            faces.push_back(key);
           }
           ++n_tets;
           break;
@@ -462,8 +465,13 @@ namespace lacerta::mesh
     }
     if (n_tets == 0)
       throw_error("Mesh file '", file_name, "' has no tetrahedra.");
-    for (const auto &[key, count] : face_count)
-      if (count > 2)
+    std::sort(faces.begin(), faces.end());
+    for (std::size_t i = 0, j = 0; i < faces.size(); i = j)
+    {
+      while (j < faces.size() && faces[j] == faces[i])
+        ++j;
+      const auto &key = faces[i];
+      if (j - i > 2)
         throw_error("Mesh file '",
                     file_name,
                     "' is not a manifold: the face with nodes ",
@@ -473,14 +481,15 @@ namespace lacerta::mesh
                     ", ",
                     node_tag[key[2]],
                     " is shared by ",
-                    count,
+                    j - i,
                     " tetrahedra.");
+    }
     // A triangle gives a boundary id; one that is no boundary face of a tetrahedron
     // cannot carry one.
     for (const auto &[key, element] : triangles)
     {
-      const auto found = face_count.find(key);
-      if (found == face_count.end() || found->second != 1)
+      const auto range = std::equal_range(faces.begin(), faces.end(), key);
+      if (range.second - range.first != 1)
         throw_error("Mesh file '",
                     file_name,
                     "', line ",
@@ -488,7 +497,7 @@ namespace lacerta::mesh
                     ": element ",
                     element->tag,
                     " (triangle) is not a boundary face of the tetrahedra",
-                    found == face_count.end() ? "" : " (it lies inside the mesh)",
+                    range.first == range.second ? "" : " (it lies inside the mesh)",
                     "; surface elements only give boundary ids.");
     }
   }
