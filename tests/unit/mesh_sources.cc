@@ -129,6 +129,52 @@ TEST(MeshSources, VtkXml)
 }
 
 
+/**
+ * Files written by gmsh itself (contrib/meshes/box.geo): the unit cube with physical
+ * surfaces 1 (x = 0) and 2 (x = 1); gmsh writes nodes of every entity, including the
+ * other faces', and triangles only where a physical group asks.
+ */
+TEST(MeshSources, GmshWrittenByGmsh)
+{
+  const TetMesh v2 = mesh_from_file("gmsh_box_v2.msh");
+  const TetMesh v4 = mesh_from_file("gmsh_box_v4.msh");
+  EXPECT_EQ(v2.n_tets(), v4.n_tets());
+  EXPECT_EQ(v2.n_vertices(), v4.n_vertices());
+  for (const TetMesh *mesh : {&v2, &v4})
+  {
+    EXPECT_GT(mesh->n_tets(), 20u);
+    EXPECT_NEAR(mesh->total_volume(), 1.0, 1e-12);
+    for (unsigned int t = 0; t < mesh->n_tets(); ++t)
+      EXPECT_GT(mesh->volume(t), 0.0);
+    // A face gets id 1 exactly when it lies in x = 0, 2 when in x = 1.
+    unsigned int n_tagged = 0;
+    double       area[3]  = {0, 0, 0};
+    for (const BoundaryFace &bf : mesh->get_boundary_faces())
+    {
+      const Tet    &t  = mesh->tet(bf.tet);
+      const auto   &fv = TetMesh::face_vertices[bf.face];
+      const Point3 &a = mesh->vertex(t[fv[0]]), &b = mesh->vertex(t[fv[1]]),
+                   &c             = mesh->vertex(t[fv[2]]);
+      const unsigned int expected = (a[0] == 0 && b[0] == 0 && c[0] == 0)   ? 1
+                                    : (a[0] == 1 && b[0] == 1 && c[0] == 1) ? 2
+                                                                            : 0;
+      EXPECT_EQ(bf.boundary_id, expected);
+      n_tagged += (bf.boundary_id != 0);
+      const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+      const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      area[std::min(bf.boundary_id, 2u)] += 0.5
+                                            * std::hypot(u[1] * w[2] - u[2] * w[1],
+                                                         u[2] * w[0] - u[0] * w[2],
+                                                         u[0] * w[1] - u[1] * w[0]);
+    }
+    EXPECT_GT(n_tagged, 0u);
+    EXPECT_NEAR(area[0], 4.0, 1e-12);
+    EXPECT_NEAR(area[1], 1.0, 1e-12);
+    EXPECT_NEAR(area[2], 1.0, 1e-12);
+  }
+}
+
+
 TEST(MeshSources, AllFormatsGiveTheSameMesh)
 {
   // The same edges, compared by the positions of their ends: the readers need not
