@@ -1,6 +1,7 @@
-// gmsh .msh files: a strict check of our own (deal.II's GridIn names neither the line
-// nor the element of a problem, and some bad elements reach assertions there), then
-// GridIn reads the file that passed.
+// gmsh .msh files: a strict check of our own, then deal.II's GridIn reads the file that
+// passed. The check is needed: GridIn (9.4.1) silently accepts a hexahedron among the
+// tetrahedra and degenerate tetrahedra, and names neither the line nor the element of
+// the problems it does find.
 
 #include <lacerta/base/exceptions.h>
 #include <lacerta/mesh/gmsh_reader.h>
@@ -27,28 +28,27 @@ namespace lacerta::mesh
     {
       const char  *name;
       unsigned int n_nodes;
-      unsigned int dim;
     };
-    constexpr ElementType  element_types[] = {{"", 0, 0},
-                                              {"line", 2, 1},
-                                              {"triangle", 3, 2},
-                                              {"quadrangle", 4, 2},
-                                              {"tetrahedron", 4, 3},
-                                              {"hexahedron", 8, 3},
-                                              {"prism", 6, 3},
-                                              {"pyramid", 5, 3},
-                                              {"second-order line", 3, 1},
-                                              {"second-order triangle", 6, 2},
-                                              {"second-order quadrangle", 9, 2},
-                                              {"second-order tetrahedron", 10, 3},
-                                              {"second-order hexahedron", 27, 3},
-                                              {"second-order prism", 18, 3},
-                                              {"second-order pyramid", 14, 3},
-                                              {"point", 1, 0},
-                                              {"8-node quadrangle", 8, 2},
-                                              {"20-node hexahedron", 20, 3},
-                                              {"15-node prism", 15, 3},
-                                              {"13-node pyramid", 13, 3}};
+    constexpr ElementType  element_types[] = {{"", 0},
+                                              {"line", 2},
+                                              {"triangle", 3},
+                                              {"quadrangle", 4},
+                                              {"tetrahedron", 4},
+                                              {"hexahedron", 8},
+                                              {"prism", 6},
+                                              {"pyramid", 5},
+                                              {"second-order line", 3},
+                                              {"second-order triangle", 6},
+                                              {"second-order quadrangle", 9},
+                                              {"second-order tetrahedron", 10},
+                                              {"second-order hexahedron", 27},
+                                              {"second-order prism", 18},
+                                              {"second-order pyramid", 14},
+                                              {"point", 1},
+                                              {"8-node quadrangle", 8},
+                                              {"20-node hexahedron", 20},
+                                              {"15-node prism", 15},
+                                              {"13-node pyramid", 13}};
     constexpr unsigned int gmsh_line = 1, gmsh_triangle = 2, gmsh_tetrahedron = 4,
                            gmsh_point = 15;
 
