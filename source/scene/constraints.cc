@@ -175,7 +175,6 @@ namespace lacerta::scene
       add_forces(const double t, physics::ParticleSystem &system) const override
       {
         force->set_time(t);
-        dealii::Vector<double> value(3);
         force->vector_value(centroid, value);
         for (const unsigned int i : particles)
           for (unsigned int d = 0; d < 3; ++d)
@@ -184,8 +183,10 @@ namespace lacerta::scene
 
     private:
       std::unique_ptr<dealii::FunctionParser<3>> force;
-      dealii::Point<3>                           centroid;
-      double                                     total_mass = 0;
+      /// Scratch for the force value, allocated once: add_forces runs every step.
+      mutable dealii::Vector<double> value = dealii::Vector<double>(3);
+      dealii::Point<3>               centroid;
+      double                         total_mass = 0;
     };
   } // namespace
 
