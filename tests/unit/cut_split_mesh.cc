@@ -206,7 +206,7 @@ TEST(CutSplitMesh, ProgressiveCutMatchesOneStroke)
   // every shape, and a small patch of the structured mesh.
   std::mt19937                           rng(5);
   std::uniform_real_distribution<double> u(-1, 1);
-  unsigned                               partial_splits = 0;
+  unsigned                               partial_splits = 0, compared = 0;
   for (unsigned run = 0; run < 62; ++run)
   {
     Mesh       mesh;
@@ -295,6 +295,7 @@ TEST(CutSplitMesh, ProgressiveCutMatchesOneStroke)
       if (k < steps)
         partial_splits += stats.split_tets;
     }
+    ++compared;
     const auto progressive = component_volumes(mesh);
     ASSERT_EQ(progressive.size(), 2u) << "run " << run;
     const double v = mesh_volume(original);
@@ -305,4 +306,5 @@ TEST(CutSplitMesh, ProgressiveCutMatchesOneStroke)
                 1e-10 * v / radius);
   }
   EXPECT_GT(partial_splits, 100u);
+  EXPECT_GE(compared, 55u); // a plane through an interior point rarely misses
 }
