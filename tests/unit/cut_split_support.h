@@ -461,6 +461,7 @@ namespace lacerta::cut::test_support
     std::size_t split_tets  = 0;
     std::size_t children    = 0;
     std::size_t unsupported = 0;
+    std::size_t partial     = 0;
   };
 
   /**
@@ -491,6 +492,7 @@ namespace lacerta::cut::test_support
         continue;
       }
       replaced[a.affected[k]] = true;
+      stats.partial += r.kind == CutKind::partial;
       ++stats.split_tets;
       stats.children += r.n_children;
       for (unsigned i = 0; i < r.n_children; ++i)
