@@ -32,10 +32,10 @@ namespace lacerta::physics
                       const double      beta,
                       double           *f)
     {
-      const unsigned int *a  = springs.a.data();
-      const unsigned int *b  = springs.b.data();
-      const double       *k  = springs.stiffness.data();
-      const double       *l0 = springs.rest_length.data();
+      const unsigned int *__restrict a = springs.a.data();
+      const unsigned int *__restrict b = springs.b.data();
+      const double *__restrict k       = springs.stiffness.data();
+      const double *__restrict l0      = springs.rest_length.data();
       for (std::size_t s = begin; s < end; ++s)
       {
         const unsigned int i         = 3 * a[s];
