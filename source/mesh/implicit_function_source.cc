@@ -2,6 +2,7 @@
 
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/parameter_utilities.h>
+#include <lacerta/base/parsed_function.h>
 #include <lacerta/mesh/mesh_source.h>
 #include <lacerta/mesh/triangulation_conversion.h>
 
@@ -16,21 +17,6 @@ namespace lacerta::mesh
   namespace
   {
     /// The parser's own explanation from a deal.II exception, without the code location.
-    std::string
-    parser_message(const dealii::ExceptionBase &e)
-    {
-      std::ostringstream info;
-      e.print_info(info);
-      std::string text = info.str();
-      for (char &c : text)
-        if (c == '\n')
-          c = ' ';
-      while (!text.empty() && text.back() == ' ')
-        text.pop_back();
-      return text;
-    }
-
-
     /**
      * The volume where an implicit function is negative, meshed with tetrahedra by
      * CGAL's Mesh_3 through GridGenerator::implicit_function.
@@ -96,25 +82,14 @@ namespace lacerta::mesh
       TetMesh
       create_mesh() const override
       {
-        const dealii::Point<3>    inside(interior_point[0],
+        const dealii::Point<3> inside(interior_point[0],
                                       interior_point[1],
                                       interior_point[2]);
-        dealii::FunctionParser<3> function(1);
-        double                    f_inside = 0;
-        // deal.II 9.4 parses the expression on its first evaluation, not in
-        // initialize(): evaluate once here so that a syntax error becomes our message.
-        try
-        {
-          function.initialize("x,y,z", expression, {});
-          f_inside = function.value(inside);
-        }
-        catch (const dealii::ExceptionBase &e)
-        {
-          throw_error("Mesh/Implicit function: cannot evaluate 'Function expression' = '",
-                      expression,
-                      "': ",
-                      parser_message(e));
-        }
+        const auto function = parse_function("Mesh/Implicit function/Function expression",
+                                             expression,
+                                             1,
+                                             false);
+        const double f_inside = function->value(inside);
         if (!(f_inside < 0))
           throw_error(
             "Mesh/Implicit function: f is not negative at 'Interior point' (f = ",
@@ -128,7 +103,7 @@ namespace lacerta::mesh
         data.cell_radius_edge_ratio = cell_radius_edge_ratio;
         dealii::Triangulation<3> triangulation;
         dealii::GridGenerator::implicit_function(
-          triangulation, function, data, inside, outer_ball_radius);
+          triangulation, *function, data, inside, outer_ball_radius);
         return tet_mesh_from_triangulation(triangulation, "implicit function");
       }
 

@@ -5,24 +5,20 @@ namespace lacerta::mesh
   void
   MeshSource::declare_parameters(dealii::ParameterHandler &prm)
   {
-    prm.enter_subsection("Mesh");
-    MeshSourceRegistry::declare_selector(prm,
-                                         "Source",
-                                         "box",
-                                         "Where the tetrahedral mesh of the object comes "
-                                         "from. Each source reads the subsection of the "
-                                         "same name (capitalised).");
-    MeshSourceRegistry::declare_all_in_subsections(prm);
-    prm.leave_subsection();
+    MeshSourceRegistry::declare_selector_subsection(
+      prm,
+      "Mesh",
+      "Source",
+      "box",
+      "Where the tetrahedral mesh of the object comes "
+      "from. Each source reads the subsection of the "
+      "same name (capitalised).");
   }
 
 
   std::unique_ptr<MeshSource>
   MeshSource::create(dealii::ParameterHandler &prm)
   {
-    prm.enter_subsection("Mesh");
-    auto source = MeshSourceRegistry::create_and_parse(prm.get("Source"), prm);
-    prm.leave_subsection();
-    return source;
+    return MeshSourceRegistry::create_selected(prm, "Mesh", "Source");
   }
 } // namespace lacerta::mesh

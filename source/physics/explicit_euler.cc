@@ -1,7 +1,7 @@
 // Integrator `explicit_euler`: forward Euler, for comparison.
 
-#include <lacerta/physics/integrator.h>
 #include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/single_evaluation_integrator.h>
 
 #include <cmath>
 #include <vector>
@@ -16,7 +16,7 @@ namespace lacerta::physics
      * for an underdamped mode |1 + λ dt| < 1 gives dt < c/ω²; for an overdamped one
      * dt < 2/|λ|.
      */
-    class ExplicitEuler : public Integrator
+    class ExplicitEuler : public SingleEvaluationIntegrator
     {
     public:
       static void
@@ -24,11 +24,6 @@ namespace lacerta::physics
       {
       }
 
-      void
-      initialize(const ParticleSystem &system) override
-      {
-        acceleration.assign(system.position.size(), 0.0);
-      }
 
       void
       step(ParticleSystem &system, const double t, const double dt) override
@@ -54,15 +49,6 @@ namespace lacerta::physics
           return c / (omega * omega);
         return 2.0 / (0.5 * c + std::sqrt(0.25 * c * c - omega * omega));
       }
-
-      unsigned int
-      n_evaluations_per_step() const override
-      {
-        return 1;
-      }
-
-    private:
-      std::vector<double> acceleration;
     };
   } // namespace
 

@@ -11,22 +11,18 @@ namespace lacerta::physics
   void
   ForceModel::declare_parameters(dealii::ParameterHandler &prm)
   {
-    prm.enter_subsection("Force model");
-    ForceModelRegistry::declare_selector(prm,
-                                         "Model",
-                                         "linear springs",
-                                         "How the springs turn elongation into force.");
-    ForceModelRegistry::declare_all_in_subsections(prm);
-    prm.leave_subsection();
+    ForceModelRegistry::declare_selector_subsection(
+      prm,
+      "Force model",
+      "Model",
+      "linear springs",
+      "How the springs turn elongation into force.");
   }
 
 
   std::unique_ptr<ForceModel>
   ForceModel::create(dealii::ParameterHandler &prm)
   {
-    prm.enter_subsection("Force model");
-    auto model = ForceModelRegistry::create_and_parse(prm.get("Model"), prm);
-    prm.leave_subsection();
-    return model;
+    return ForceModelRegistry::create_selected(prm, "Force model", "Model");
   }
 } // namespace lacerta::physics

@@ -13,26 +13,21 @@ namespace lacerta::physics
   void
   Integrator::declare_parameters(dealii::ParameterHandler &prm)
   {
-    prm.enter_subsection("Integrator");
-    IntegratorRegistry::declare_selector(
+    IntegratorRegistry::declare_selector_subsection(
       prm,
+      "Integrator",
       "Scheme",
       "rk4",
       "The explicit time integration scheme. Its stable "
       "time step is printed before the run (see "
       "doc/stability.md).");
-    IntegratorRegistry::declare_all_in_subsections(prm);
-    prm.leave_subsection();
   }
 
 
   std::unique_ptr<Integrator>
   Integrator::create(dealii::ParameterHandler &prm)
   {
-    prm.enter_subsection("Integrator");
-    auto integrator = IntegratorRegistry::create_and_parse(prm.get("Scheme"), prm);
-    prm.leave_subsection();
-    return integrator;
+    return IntegratorRegistry::create_selected(prm, "Integrator", "Scheme");
   }
 
 

@@ -1,7 +1,7 @@
 // Integrator `symplectic_euler`: semi-implicit Euler, velocity first.
 
-#include <lacerta/physics/integrator.h>
 #include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/single_evaluation_integrator.h>
 
 #include <vector>
 
@@ -13,7 +13,7 @@ namespace lacerta::physics
      * v += dt a(x, v); x += dt v. First order, symplectic: the energy of an undamped
      * system stays bounded for any stable step.
      */
-    class SymplecticEuler : public Integrator
+    class SymplecticEuler : public SingleEvaluationIntegrator
     {
     public:
       static void
@@ -21,11 +21,6 @@ namespace lacerta::physics
       {
       }
 
-      void
-      initialize(const ParticleSystem &system) override
-      {
-        acceleration.assign(system.position.size(), 0.0);
-      }
 
       void
       step(ParticleSystem &system, const double t, const double dt) override
@@ -49,15 +44,6 @@ namespace lacerta::physics
         return symplectic_critical_time_step(
           omega, modal_damping(omega, mass_damping, spring_damping));
       }
-
-      unsigned int
-      n_evaluations_per_step() const override
-      {
-        return 1;
-      }
-
-    private:
-      std::vector<double> acceleration;
     };
   } // namespace
 

@@ -1,7 +1,7 @@
 // Integrator `velocity_verlet`: the second-order symplectic leapfrog.
 
-#include <lacerta/physics/integrator.h>
 #include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/single_evaluation_integrator.h>
 
 #include <vector>
 
@@ -15,7 +15,7 @@ namespace lacerta::physics
      * step costs one evaluation; velocity-dependent forces (damping) are evaluated with
      * the half-step velocity.
      */
-    class VelocityVerlet : public Integrator
+    class VelocityVerlet : public SingleEvaluationIntegrator
     {
     public:
       static void
@@ -26,7 +26,7 @@ namespace lacerta::physics
       void
       initialize(const ParticleSystem &system) override
       {
-        acceleration.assign(system.position.size(), 0.0);
+        SingleEvaluationIntegrator::initialize(system);
         acceleration_is_current = false;
       }
 
@@ -60,15 +60,8 @@ namespace lacerta::physics
           omega, modal_damping(omega, mass_damping, spring_damping));
       }
 
-      unsigned int
-      n_evaluations_per_step() const override
-      {
-        return 1;
-      }
 
-    private:
-      std::vector<double> acceleration;
-      bool                acceleration_is_current = false;
+      bool acceleration_is_current = false;
     };
   } // namespace
 

@@ -2,6 +2,7 @@
 
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/parameter_utilities.h>
+#include <lacerta/base/parsed_function.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/scene/body_force.h>
 
@@ -65,20 +66,10 @@ namespace lacerta::scene
       parse_parameters(dealii::ParameterHandler &prm) override
       {
         expression = prm.get("Acceleration");
-        field      = std::make_unique<dealii::FunctionParser<3>>(3);
-        try
-        {
-          field->initialize("x,y,z,t", expression, {}, true);
-        }
-        catch (const dealii::ExceptionBase &e)
-        {
-          std::ostringstream info;
-          e.print_info(info);
-          throw_error("Body forces/Acceleration field: cannot use 'Acceleration' = '",
-                      expression,
-                      "': ",
-                      info.str());
-        }
+        field      = parse_function("Body forces/Acceleration field/Acceleration",
+                               expression,
+                               3,
+                               true);
       }
 
       bool

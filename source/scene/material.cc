@@ -1,14 +1,14 @@
 #include <lacerta/base/exceptions.h>
+#include <lacerta/base/parsed_function.h>
 #include <lacerta/scene/material.h>
 
 namespace lacerta::scene
 {
   namespace
   {
-    std::unique_ptr<dealii::FunctionParser<3>>
-    parse_field(const std::string &entry,
-                const std::string &expression,
-                const std::string &constants)
+    /// Parses `name=value, name=value` into constants for the expressions.
+    std::map<std::string, double>
+    parse_constants(const std::string &constants)
     {
       std::map<std::string, double> values;
       for (const auto &pair : dealii::Utilities::split_string_list(constants, ','))
@@ -20,24 +20,7 @@ namespace lacerta::scene
                       "' is not of the form name=value.");
         values[parts[0]] = dealii::Utilities::string_to_double(parts[1]);
       }
-      auto function = std::make_unique<dealii::FunctionParser<3>>(1);
-      try
-      {
-        function->initialize("x,y,z", expression, values);
-        function->value(dealii::Point<3>());
-      }
-      catch (const dealii::ExceptionBase &e)
-      {
-        std::ostringstream info;
-        e.print_info(info);
-        throw_error("Material/",
-                    entry,
-                    ": cannot evaluate the expression '",
-                    expression,
-                    "': ",
-                    info.str());
-      }
-      return function;
+      return values;
     }
   } // namespace
 
@@ -85,12 +68,14 @@ namespace lacerta::scene
   Material::parse_parameters(dealii::ParameterHandler &prm)
   {
     prm.enter_subsection("Material");
-    const std::string constants = prm.get("Function constants");
-    density_function            = parse_field("Density", prm.get("Density"), constants);
-    youngs_function = parse_field("Youngs modulus", prm.get("Youngs modulus"), constants);
-    poisson_ratio   = prm.get_double("Poisson ratio");
-    mass_damping    = prm.get_double("Mass damping");
-    spring_damping  = prm.get_double("Spring damping");
+    const auto constants = parse_constants(prm.get("Function constants"));
+    density_function =
+      parse_function("Material/Density", prm.get("Density"), 1, false, constants);
+    youngs_function = parse_function(
+      "Material/Youngs modulus", prm.get("Youngs modulus"), 1, false, constants);
+    poisson_ratio  = prm.get_double("Poisson ratio");
+    mass_damping   = prm.get_double("Mass damping");
+    spring_damping = prm.get_double("Spring damping");
     prm.leave_subsection();
   }
 } // namespace lacerta::scene

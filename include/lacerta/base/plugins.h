@@ -158,6 +158,38 @@ namespace lacerta
     }
 
     /**
+     * Declares `subsection @p subsection` holding the selector @p entry_name and the
+     * subsections of every plugin: the layout of a kind that has one active plugin.
+     */
+    static void
+    declare_selector_subsection(dealii::ParameterHandler &prm,
+                                const std::string        &subsection,
+                                const std::string        &entry_name,
+                                const std::string        &default_name,
+                                const std::string        &preamble)
+    {
+      prm.enter_subsection(subsection);
+      declare_selector(prm, entry_name, default_name, preamble);
+      declare_all_in_subsections(prm);
+      prm.leave_subsection();
+    }
+
+    /**
+     * Creates the plugin selected by @p entry_name in `subsection @p subsection`, with
+     * its parameters read.
+     */
+    static std::unique_ptr<InterfaceType>
+    create_selected(dealii::ParameterHandler &prm,
+                    const std::string        &subsection,
+                    const std::string        &entry_name)
+    {
+      prm.enter_subsection(subsection);
+      std::unique_ptr<InterfaceType> plugin = create_and_parse(prm.get(entry_name), prm);
+      prm.leave_subsection();
+      return plugin;
+    }
+
+    /**
      * Creates plugin @p name and lets it read its parameters from its subsection of the
      * current subsection.
      */

@@ -1,0 +1,55 @@
+#include <lacerta/base/exceptions.h>
+#include <lacerta/base/parsed_function.h>
+
+#include <deal.II/base/exceptions.h>
+
+namespace lacerta
+{
+  std::string
+  exception_message(const dealii::ExceptionBase &exception)
+  {
+    std::ostringstream info;
+    exception.print_info(info);
+    std::string text = info.str();
+    for (char &c : text)
+      if (c == '\n')
+        c = ' ';
+    const auto first = text.find_first_not_of(' ');
+    const auto last  = text.find_last_not_of(' ');
+    return first == std::string::npos ? std::string()
+                                      : text.substr(first, last - first + 1);
+  }
+
+
+  std::unique_ptr<dealii::FunctionParser<3>>
+  parse_function(const std::string                   &entry,
+                 const std::string                   &expression,
+                 const unsigned int                   n_components,
+                 const bool                           time_dependent,
+                 const std::map<std::string, double> &constants)
+  {
+    auto function = std::make_unique<dealii::FunctionParser<3>>(n_components);
+    try
+    {
+      function->initialize(time_dependent ? "x,y,z,t" : "x,y,z",
+                           expression,
+                           constants,
+                           time_dependent);
+      for (unsigned int c = 0; c < n_components; ++c)
+        function->value(dealii::Point<3>(), c);
+    }
+    catch (const dealii::ExceptionBase &e)
+    {
+      throw_error(entry,
+                  ": cannot evaluate the expression '",
+                  expression,
+                  "'",
+                  n_components > 1 ? " (" + std::to_string(n_components)
+                                       + " components separated by ';' are needed)"
+                                   : std::string(),
+                  ": ",
+                  exception_message(e));
+    }
+    return function;
+  }
+} // namespace lacerta
