@@ -64,6 +64,15 @@ namespace lacerta::scene
                       "Poisson ratio of the FEM reference. A spring lattice behaves like "
                       "ν = 1/4 whatever is asked here.");
     prm.declare_entry(
+      "Spring stiffness",
+      "paper",
+      dealii::Patterns::Selection("paper|fitted"),
+      "How springs get their stiffness: 'paper' sums E V / |e|^2 over the "
+      "tetrahedra of an edge (Section 3.2); 'fitted' sums the stiffnesses that fit "
+      "each tetrahedron's linear FEM stiffness with 'Poisson ratio' best in least "
+      "squares (Lloyd, Szekely, Harders 2007; doc/accuracy.md compares both). Both cost "
+      "the same per step.");
+    prm.declare_entry(
       "Function constants",
       "",
       dealii::Patterns::Anything(),
@@ -89,6 +98,7 @@ namespace lacerta::scene
     density_function            = parse_field("Density", prm.get("Density"), constants);
     youngs_function = parse_field("Youngs modulus", prm.get("Youngs modulus"), constants);
     poisson_ratio   = prm.get_double("Poisson ratio");
+    fitted_springs  = prm.get("Spring stiffness") == "fitted";
     mass_damping    = prm.get_double("Mass damping");
     spring_damping  = prm.get_double("Spring damping");
     prm.leave_subsection();
