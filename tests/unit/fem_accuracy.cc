@@ -12,11 +12,11 @@
 #include <deal.II/base/function.h>
 
 #include <gtest/gtest.h>
-#include <mpi.h>
 
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <mpi.h>
 
 namespace
 {
@@ -51,7 +51,7 @@ namespace
 
   /// The scene of @p file, with @p adjust applied to its parameters first.
   std::unique_ptr<scene::Scene>
-  load_scene(const std::string                             &file,
+  load_scene(const std::string                                     &file,
              const std::function<void(dealii::ParameterHandler &)> &adjust = {})
   {
     dealii::ParameterHandler prm;
@@ -62,7 +62,7 @@ namespace
   }
 
   void
-  set_entry(dealii::ParameterHandler        &prm,
+  set_entry(dealii::ParameterHandler       &prm,
             const std::vector<std::string> &path,
             const std::string              &entry,
             const std::string              &value)
@@ -77,21 +77,21 @@ namespace
   /// The cantilever of prm/cantilever.prm with its box refined @p factor times.
   std::unique_ptr<scene::Scene>
   cantilever(const unsigned int factor,
-             const std::string &gravity = "0, 0, -9.81",
+             const std::string &gravity   = "0, 0, -9.81",
              const std::string &stiffness = "paper")
   {
-    return load_scene("cantilever.prm",
-                      [&](dealii::ParameterHandler &prm)
-                      {
-                        set_entry(prm,
-                                  {"Mesh", "Box"},
-                                  "Repetitions",
-                                  std::to_string(10 * factor) + ", "
-                                    + std::to_string(2 * factor) + ", "
-                                    + std::to_string(2 * factor));
-                        set_entry(prm, {"Body forces", "Gravity"}, "Acceleration", gravity);
-                        set_entry(prm, {"Material"}, "Spring stiffness", stiffness);
-                      });
+    return load_scene(
+      "cantilever.prm",
+      [&](dealii::ParameterHandler &prm)
+      {
+        set_entry(prm,
+                  {"Mesh", "Box"},
+                  "Repetitions",
+                  std::to_string(10 * factor) + ", " + std::to_string(2 * factor) + ", "
+                    + std::to_string(2 * factor));
+        set_entry(prm, {"Body forces", "Gravity"}, "Acceleration", gravity);
+        set_entry(prm, {"Material"}, "Spring stiffness", stiffness);
+      });
   }
 
   /// Mean vertical displacement of the vertices at the free end x = L.
@@ -123,13 +123,16 @@ namespace
   {
     auto         scene = cantilever(1, "0, 0, 0");
     const double eps = 1e-3, nu = 0.25;
-    fem::Problem problem = fem::problem_from_scene(*scene);
+    fem::Problem problem  = fem::problem_from_scene(*scene);
     problem.poisson_ratio = nu;
     for (unsigned int v = 0; v < scene->mesh.n_vertices(); ++v)
       problem.prescribed[v] =
         scene->mesh.vertex(v)[0] < 1e-9 || scene->mesh.vertex(v)[0] > 0.1 - 1e-9;
-    const auto exact = [&](const mesh::Point3 &x) {
-      return mesh::Point3{eps * x[0], -nu * eps * (x[1] - 0.01), -nu * eps * (x[2] - 0.01)};
+    const auto exact = [&](const mesh::Point3 &x)
+    {
+      return mesh::Point3{eps * x[0],
+                          -nu * eps * (x[1] - 0.01),
+                          -nu * eps * (x[2] - 0.01)};
     };
     problem.displacement = [&](double, std::vector<double> &u)
     {
@@ -144,11 +147,12 @@ namespace
       parameters.degree    = degree;
       parameters.tolerance = 1e-12;
       fem::ElasticitySolver solver(problem, parameters);
-      const fem::NodalField u = solver.solve_static();
+      const fem::NodalField u     = solver.solve_static();
       double                worst = 0;
       for (unsigned int v = 0; v < scene->mesh.n_vertices(); ++v)
         for (unsigned int d = 0; d < 3; ++d)
-          worst = std::max(worst, std::abs(u.at_vertex(v)[d] - exact(scene->mesh.vertex(v))[d]));
+          worst = std::max(worst,
+                           std::abs(u.at_vertex(v)[d] - exact(scene->mesh.vertex(v))[d]));
       EXPECT_LT(worst, 1e-9 * eps * 0.1) << "degree " << degree;
     }
   }
@@ -158,7 +162,7 @@ namespace
   /// deflection rather than Euler-Bernoulli's (the beam is only 5 heights long).
   TEST(FemAccuracy, CantileverP2ConvergesToBeamTheory)
   {
-    double previous = 0;
+    double              previous = 0;
     std::vector<double> tips;
     for (const unsigned int factor : {1u, 2u})
     {
@@ -184,10 +188,10 @@ namespace
          std::vector<std::pair<std::string, double>>{{"0, 0, -0.0981", 1e-3},
                                                      {"0, 0, -9.81", 2e-2}})
     {
-      auto                      scene  = cantilever(1, gravity);
-      const std::vector<double> direct = fem::solve_linearised_springs(*scene->system);
+      auto                        scene   = cantilever(1, gravity);
+      const std::vector<double>   direct  = fem::solve_linearised_springs(*scene->system);
       const fem::RelaxationResult relaxed = fem::relax_springs(*scene->system, 1e-7);
-      double                    difference = 0, norm = 0;
+      double                      difference = 0, norm = 0;
       for (std::size_t k = 0; k < direct.size(); ++k)
       {
         difference += std::pow(direct[k] - relaxed.displacement[k], 2);
@@ -208,8 +212,8 @@ namespace
     fem::ElasticitySolver solver(fem::problem_from_scene(*reference_scene), {});
     const double          reference =
       -tip_deflection(reference_scene->mesh, solver.solve_static().vertex);
-    auto paper  = cantilever(1);
-    auto fitted = cantilever(1, "0, 0, -9.81", "fitted");
+    auto         paper  = cantilever(1);
+    auto         fitted = cantilever(1, "0, 0, -9.81", "fitted");
     const double paper_tip =
       -tip_deflection(paper->mesh, fem::solve_linearised_springs(*paper->system));
     const double fitted_tip =
@@ -233,7 +237,7 @@ namespace
     auto                  scene = cantilever(1);
     fem::SolverParameters parameters;
     fem::ElasticitySolver solver(fem::problem_from_scene(*scene), parameters);
-    const double          static_tip = tip_deflection(scene->mesh, solver.solve_static().vertex);
+    const double static_tip = tip_deflection(scene->mesh, solver.solve_static().vertex);
     solver.start_dynamic(2e-3);
     for (unsigned int step = 0; step < 500; ++step)
       solver.advance();
@@ -257,7 +261,7 @@ namespace
   {
     auto        scene = cantilever(1, "0, 0, 0");
     const auto &mesh  = scene->mesh;
-    const auto  f = [](const mesh::Point3 &x) {
+    const auto  f     = [](const mesh::Point3 &x) {
       return mesh::Point3{x[0] * x[0] + x[1], x[1] * x[2] - 2 * x[0], 3 * x[2] * x[2]};
     };
     fem::NodalField field;
