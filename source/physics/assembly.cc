@@ -6,6 +6,7 @@
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/vector.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
@@ -201,7 +202,7 @@ namespace lacerta::physics
                          const dealii::Function<3, double> &youngs_modulus,
                          const double                       poisson_ratio)
   {
-    return springs_from_contributions(
+    SpringSet springs = springs_from_contributions(
       mesh,
       [&](const unsigned int t, const std::vector<double> &)
       {
@@ -274,5 +275,13 @@ namespace lacerta::physics
         }
         return k;
       });
+    // An edge dropped by every tetrahedron it belongs to (a boundary edge of a single
+    // tetrahedron, typically) would have no stiffness at all; the springs keep the
+    // mesh's topology, so it gets a token 1e-6 of the stiffest spring instead.
+    const double floor =
+      1e-6 * *std::max_element(springs.stiffness.begin(), springs.stiffness.end());
+    for (double &k : springs.stiffness)
+      k = std::max(k, floor);
+    return springs;
   }
 } // namespace lacerta::physics

@@ -49,7 +49,8 @@ namespace lacerta::physics
    * minimise the Frobenius norm |K_τ - Σ_e k_e n_e n_eᵀ blocks| between the linear
    * (P1) FEM stiffness of τ with E at its centroid and Poisson ratio @p poisson_ratio,
    * and the linearised stiffness of its springs. An edge whose fit would be negative is
-   * dropped from τ and the others refitted. Same order and rest lengths as
+   * dropped from τ and the others refitted; an edge dropped by all its tetrahedra keeps
+   * a token 1e-6 of the stiffest spring. Same order and rest lengths as
    * compute_springs().
    */
   SpringSet
