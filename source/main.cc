@@ -1,6 +1,7 @@
 // lacerta: runs a scene described by a parameter file.
 
 #include <lacerta/base/exceptions.h>
+#include <lacerta/fem/study.h>
 #include <lacerta/simulator/simulator.h>
 
 #include <deal.II/base/exceptions.h>
@@ -31,8 +32,13 @@ main(int argc, char **argv)
   {
     dealii::ParameterHandler prm;
     lacerta::Simulator::read_parameters(argv[1], prm);
-    lacerta::Simulator simulator(prm, argv[1]);
-    simulator.run();
+    if (prm.get("Mode") == "study")
+      lacerta::fem::Study(prm).run();
+    else
+    {
+      lacerta::Simulator simulator(prm, argv[1]);
+      simulator.run();
+    }
   }
   catch (const lacerta::Error &e)
   {

@@ -2,8 +2,13 @@
 
 #include <deal.II/base/function.h>
 #include <deal.II/base/quadrature_lib.h>
+#include <deal.II/base/tensor.h>
+#include <deal.II/lac/full_matrix.h>
+#include <deal.II/lac/vector.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 
 namespace lacerta::physics
 {
@@ -89,34 +94,194 @@ namespace lacerta::physics
   }
 
 
-  SpringSet
-  compute_springs(const mesh::TetMesh               &mesh,
-                  const dealii::Function<3, double> &youngs_modulus)
+  namespace
   {
-    const auto         &edges = mesh.get_edges();
-    std::vector<double> length(edges.size());
-    for (unsigned int e = 0; e < edges.size(); ++e)
-    {
-      const mesh::Point3 &a = mesh.vertex(edges[e][0]);
-      const mesh::Point3 &b = mesh.vertex(edges[e][1]);
-      length[e]             = std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
-    }
-
-    std::vector<double> stiffness(edges.size(), 0.0);
-    for (unsigned int t = 0; t < mesh.n_tets(); ++t)
+    /// Centroid of tetrahedron @p t, where E is evaluated for the whole tetrahedron.
+    dealii::Point<3>
+    centroid_of(const mesh::TetMesh &mesh, const unsigned int t)
     {
       dealii::Point<3> centroid;
       for (const unsigned int v : mesh.tet(t))
         for (unsigned int d = 0; d < 3; ++d)
           centroid[d] += 0.25 * mesh.vertex(v)[d];
-      const double e_times_v = youngs_modulus.value(centroid) * mesh.volume(t);
-      for (const unsigned int e : mesh.tet_edges(t))
-        stiffness[e] += e_times_v / (length[e] * length[e]);
+      return centroid;
     }
 
-    SpringSet springs;
-    for (unsigned int e = 0; e < edges.size(); ++e)
-      springs.push_back(edges[e][0], edges[e][1], stiffness[e], length[e]);
+
+    /**
+     * One spring per unique edge with rest length |e| and the stiffness summed over the
+     * tetrahedra of the edge; @p contribution gives tetrahedron t's share to its six
+     * edges (local edge order) from the rest lengths of all edges.
+     */
+    SpringSet
+    springs_from_contributions(
+      const mesh::TetMesh &mesh,
+      const std::function<
+        std::array<double, 6>(unsigned int, const std::vector<double> &)> &contribution)
+    {
+      const auto         &edges = mesh.get_edges();
+      std::vector<double> length(edges.size());
+      for (unsigned int e = 0; e < edges.size(); ++e)
+      {
+        const mesh::Point3 &a = mesh.vertex(edges[e][0]);
+        const mesh::Point3 &b = mesh.vertex(edges[e][1]);
+        length[e]             = std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+      }
+
+      std::vector<double> stiffness(edges.size(), 0.0);
+      for (unsigned int t = 0; t < mesh.n_tets(); ++t)
+      {
+        const std::array<double, 6> k = contribution(t, length);
+        for (unsigned int i = 0; i < 6; ++i)
+          stiffness[mesh.tet_edges(t)[i]] += k[i];
+      }
+
+      SpringSet springs;
+      for (unsigned int e = 0; e < edges.size(); ++e)
+        springs.push_back(edges[e][0], edges[e][1], stiffness[e], length[e]);
+      return springs;
+    }
+
+
+    /**
+     * The 12x12 stiffness matrix of a linear (P1) tetrahedron with Lamé parameters
+     * λ, μ, rows and columns ordered (vertex, component).
+     */
+    dealii::FullMatrix<double>
+    p1_element_stiffness(const std::array<mesh::Point3, 4> &x,
+                         const double                       lambda,
+                         const double                       mu)
+    {
+      dealii::Tensor<2, 3> jacobian;
+      for (unsigned int i = 0; i < 3; ++i)
+        for (unsigned int d = 0; d < 3; ++d)
+          jacobian[d][i] = x[i + 1][d] - x[0][d];
+      const double               volume  = std::abs(dealii::determinant(jacobian)) / 6;
+      const dealii::Tensor<2, 3> inverse = dealii::invert(jacobian);
+      // Gradients of the barycentric coordinates: rows of J⁻¹ for vertices 1..3.
+      std::array<dealii::Tensor<1, 3>, 4> g;
+      for (unsigned int i = 0; i < 3; ++i)
+        for (unsigned int d = 0; d < 3; ++d)
+          g[i + 1][d] = inverse[i][d];
+      g[0] = -(g[1] + g[2] + g[3]);
+      dealii::FullMatrix<double> k(12, 12);
+      for (unsigned int i = 0; i < 4; ++i)
+        for (unsigned int j = 0; j < 4; ++j)
+          for (unsigned int c = 0; c < 3; ++c)
+            for (unsigned int d = 0; d < 3; ++d)
+              k(3 * i + c, 3 * j + d) =
+                volume
+                * (lambda * g[i][c] * g[j][d] + mu * g[i][d] * g[j][c]
+                   + (c == d ? mu * (g[i] * g[j]) : 0.0));
+      return k;
+    }
+  } // namespace
+
+
+  SpringSet
+  compute_springs(const mesh::TetMesh               &mesh,
+                  const dealii::Function<3, double> &youngs_modulus)
+  {
+    return springs_from_contributions(
+      mesh,
+      [&](const unsigned int t, const std::vector<double> &length)
+      {
+        const double e_times_v =
+          youngs_modulus.value(centroid_of(mesh, t)) * mesh.volume(t);
+        std::array<double, 6> k{};
+        for (unsigned int i = 0; i < 6; ++i)
+          k[i] =
+            e_times_v / (length[mesh.tet_edges(t)[i]] * length[mesh.tet_edges(t)[i]]);
+        return k;
+      });
+  }
+
+
+  SpringSet
+  compute_fitted_springs(const mesh::TetMesh               &mesh,
+                         const dealii::Function<3, double> &youngs_modulus,
+                         const double                       poisson_ratio)
+  {
+    SpringSet springs = springs_from_contributions(
+      mesh,
+      [&](const unsigned int t, const std::vector<double> &)
+      {
+        std::array<mesh::Point3, 4> x;
+        for (unsigned int i = 0; i < 4; ++i)
+          x[i] = mesh.vertex(mesh.tet(t)[i]);
+        const double E  = youngs_modulus.value(centroid_of(mesh, t));
+        const double nu = poisson_ratio;
+        const auto   target =
+          p1_element_stiffness(x, E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu)));
+        // The stiffness of a unit spring on each local edge: k n nᵀ blocks.
+        std::array<dealii::FullMatrix<double>, 6> unit;
+        for (unsigned int e = 0; e < 6; ++e)
+        {
+          const auto [a, b] = mesh::TetMesh::edge_vertices[e];
+          dealii::Tensor<1, 3> n;
+          for (unsigned int d = 0; d < 3; ++d)
+            n[d] = x[b][d] - x[a][d];
+          n /= n.norm();
+          unit[e].reinit(12, 12);
+          for (unsigned int c = 0; c < 3; ++c)
+            for (unsigned int d = 0; d < 3; ++d)
+            {
+              const double v                = n[c] * n[d];
+              unit[e](3 * a + c, 3 * a + d) = unit[e](3 * b + c, 3 * b + d) = v;
+              unit[e](3 * a + c, 3 * b + d) = unit[e](3 * b + c, 3 * a + d) = -v;
+            }
+        }
+        // Least squares in the Frobenius norm, min |K_e - Σ k_i S_i|, over k >= 0: the
+        // normal equations on the edges still active; an edge whose stiffness comes out
+        // negative (a spring cannot push back in tension) is dropped and the rest refit.
+        std::array<bool, 6>   active{true, true, true, true, true, true};
+        std::array<double, 6> k{};
+        for (unsigned int pass = 0; pass < 6; ++pass)
+        {
+          std::vector<unsigned int> index;
+          for (unsigned int e = 0; e < 6; ++e)
+            if (active[e])
+              index.push_back(e);
+          const unsigned int         m = index.size();
+          dealii::FullMatrix<double> normal(m, m);
+          dealii::Vector<double>     rhs(m), solution(m);
+          for (unsigned int i = 0; i < m; ++i)
+          {
+            for (unsigned int j = 0; j < m; ++j)
+              for (unsigned int r = 0; r < 12; ++r)
+                for (unsigned int c = 0; c < 12; ++c)
+                  normal(i, j) += unit[index[i]](r, c) * unit[index[j]](r, c);
+            for (unsigned int r = 0; r < 12; ++r)
+              for (unsigned int c = 0; c < 12; ++c)
+                rhs(i) += unit[index[i]](r, c) * target(r, c);
+          }
+          normal.gauss_jordan();
+          normal.vmult(solution, rhs);
+          k.fill(0.0);
+          bool all_positive = true;
+          for (unsigned int i = 0; i < m; ++i)
+          {
+            k[index[i]] = solution(i);
+            if (solution(i) < 0)
+            {
+              active[index[i]] = false;
+              all_positive     = false;
+            }
+          }
+          if (all_positive)
+            break;
+          for (double &value : k)
+            value = std::max(value, 0.0);
+        }
+        return k;
+      });
+    // An edge dropped by every tetrahedron it belongs to (a boundary edge of a single
+    // tetrahedron, typically) would have no stiffness at all; the springs keep the
+    // mesh's topology, so it gets a token 1e-6 of the stiffest spring instead.
+    const double floor =
+      1e-6 * *std::max_element(springs.stiffness.begin(), springs.stiffness.end());
+    for (double &k : springs.stiffness)
+      k = std::max(k, floor);
     return springs;
   }
 } // namespace lacerta::physics

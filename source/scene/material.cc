@@ -44,8 +44,18 @@ namespace lacerta::scene
     prm.declare_entry("Poisson ratio",
                       "0.25",
                       dealii::Patterns::Double(0.0, 0.499),
-                      "Poisson ratio of the FEM reference. A spring lattice behaves like "
-                      "ν = 1/4 whatever is asked here.");
+                      "Poisson ratio of the FEM reference and of the fitted springs. The "
+                      "paper's springs contract with their own effective ratio whatever is "
+                      "asked here (doc/accuracy.md)."));
+    prm.declare_entry(
+      "Spring stiffness",
+      "paper",
+      dealii::Patterns::Selection("paper|fitted"),
+      "How springs get their stiffness: 'paper' sums E V / |e|^2 over the "
+      "tetrahedra of an edge (Section 3.2); 'fitted' sums the stiffnesses that fit "
+      "each tetrahedron's linear FEM stiffness with 'Poisson ratio' best in least "
+      "squares (Lloyd, Szekely, Harders 2007; doc/accuracy.md compares both). Both cost "
+      "the same per step.");
     prm.declare_entry(
       "Function constants",
       "",
@@ -74,6 +84,7 @@ namespace lacerta::scene
     youngs_function = parse_function(
       "Material/Youngs modulus", prm.get("Youngs modulus"), 1, false, constants);
     poisson_ratio  = prm.get_double("Poisson ratio");
+    fitted_springs = prm.get("Spring stiffness") == "fitted";
     mass_damping   = prm.get_double("Mass damping");
     spring_damping = prm.get_double("Spring damping");
     prm.leave_subsection();

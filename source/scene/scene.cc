@@ -51,7 +51,11 @@ namespace lacerta::scene
                     system->mass[i],
                     " kg; the density must be positive and finite on the object.");
 
-    system->springs = physics::compute_springs(mesh, material.youngs_modulus());
+    system->springs = material.fitted_springs
+                        ? physics::compute_fitted_springs(mesh,
+                                                          material.youngs_modulus(),
+                                                          material.poisson_ratio)
+                        : physics::compute_springs(mesh, material.youngs_modulus());
     for (std::size_t s = 0; s < system->springs.size(); ++s)
       if (!(system->springs.stiffness[s] > 0)
           || !std::isfinite(system->springs.stiffness[s]))

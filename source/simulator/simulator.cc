@@ -1,5 +1,6 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/input_path.h>
+#include <lacerta/fem/study.h>
 #include <lacerta/physics/integrator.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/stability.h>
@@ -109,6 +110,11 @@ namespace lacerta
       dealii::Patterns::DirectoryName(),
       "Where the run writes its files (created if needed); the parameters "
       "it used are copied there as parameters.prm.");
+    prm.declare_entry("Mode",
+                      "simulation",
+                      dealii::Patterns::Selection("simulation|study"),
+                      "'simulation' runs the scene in time; 'study' runs the variants of "
+                      "'subsection Study' (error against run time, doc/accuracy.md).");
     prm.declare_entry("End time",
                       "1",
                       dealii::Patterns::Double(0.0, 1e6),
@@ -160,6 +166,7 @@ namespace lacerta
     scene::Scene::declare_parameters(prm, constraint_names);
     physics::Integrator::declare_parameters(prm);
     postprocess::Postprocessor::declare_parameters(prm);
+    fem::Study::declare_parameters(prm);
   }
 
 

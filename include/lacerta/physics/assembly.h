@@ -42,4 +42,19 @@ namespace lacerta::physics
   SpringSet
   compute_springs(const mesh::TetMesh               &mesh,
                   const dealii::Function<3, double> &youngs_modulus);
+
+  /**
+   * Springs fitted to linear elasticity (beyond the paper; Lloyd, Székely and Harders,
+   * IEEE TVCG 2007): tetrahedron τ gives its six edges the stiffnesses k ≥ 0 that
+   * minimise the Frobenius norm |K_τ - Σ_e k_e n_e n_eᵀ blocks| between the linear
+   * (P1) FEM stiffness of τ with E at its centroid and Poisson ratio @p poisson_ratio,
+   * and the linearised stiffness of its springs. An edge whose fit would be negative is
+   * dropped from τ and the others refitted; an edge dropped by all its tetrahedra keeps
+   * a token 1e-6 of the stiffest spring. Same order and rest lengths as
+   * compute_springs().
+   */
+  SpringSet
+  compute_fitted_springs(const mesh::TetMesh               &mesh,
+                         const dealii::Function<3, double> &youngs_modulus,
+                         double                             poisson_ratio);
 } // namespace lacerta::physics

@@ -42,6 +42,9 @@ namespace lacerta::scene
 
     /// Poisson ratio (used by the FEM reference; springs behave as ν = 1/4).
     double poisson_ratio = 0.25;
+    /// Whether spring stiffnesses are fitted to linear elasticity (Lloyd et al. 2007)
+    /// instead of the paper's k = E V / |e|².
+    bool fitted_springs = false;
     /// Viscous damping per particle (1/s).
     double mass_damping = 0;
     /// Damping along springs (s).

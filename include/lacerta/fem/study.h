@@ -1,0 +1,66 @@
+/**
+ * @file
+ * The error-against-run-time study (`set Mode = study`): runs every variant of a scene
+ * (mesh refinement x model x integrator x time step), times it, measures its error
+ * against a FEM P2 reference and writes study.csv and study.png.
+ */
+#pragma once
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <string>
+#include <vector>
+
+namespace lacerta::fem
+{
+  /**
+   * One row of the study: a variant, its cost and its error.
+   */
+  struct StudyRow
+  {
+    std::string  variant, model, integrator;
+    unsigned int tets      = 0;
+    double       time_step = 0;
+    double       wall_time = 0;
+    double       error_l2  = 0;
+    double       error_max = 0;
+  };
+
+
+  /**
+   * The study driver. Variants share the scene of the parameter file; a refinement
+   * multiplies `Mesh/Box/Repetitions`. Static analysis: springs by direct solve,
+   * dynamic relaxation or an explicit integrator run to `End time`, FEM by CG-AMG;
+   * the reference is FEM P2 on the mesh refined `Reference refinement` times.
+   * Dynamic analysis: springs by explicit integrators, FEM by Newmark, errors over the
+   * nodes at `Number of samples` times, against FEM P2 Newmark on the reference mesh.
+   * FEM runs on all MPI ranks; the serial spring variants run on every rank.
+   */
+  class Study
+  {
+  public:
+    /// Declares `subsection Study`.
+    static void
+    declare_parameters(dealii::ParameterHandler &prm);
+
+    /// Reads the study from @p prm (the whole scene's parameters).
+    explicit Study(dealii::ParameterHandler &prm);
+
+    /// Runs every variant, prints the table and writes study.csv (and study.png).
+    std::vector<StudyRow>
+    run();
+
+  private:
+    dealii::ParameterHandler &prm;
+    bool                      dynamic;
+    std::vector<unsigned int> refinements;
+    std::vector<std::string>  models, integrators;
+    std::vector<double>       time_steps;
+    unsigned int              reference_refinement;
+    double                    reference_time_step;
+    unsigned int              n_samples;
+    bool                      plot;
+    std::string               plot_script, output_directory;
+    bool                      test_mode;
+  };
+} // namespace lacerta::fem
