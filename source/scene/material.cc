@@ -41,12 +41,13 @@ namespace lacerta::scene
                       "Young's modulus E(x, y, z) [Pa], an expression; evaluated at the "
                       "centroid of every tetrahedron for the spring stiffness "
                       "k_e = sum E V / |e|^2 (Section 3.2).");
-    prm.declare_entry("Poisson ratio",
-                      "0.25",
-                      dealii::Patterns::Double(0.0, 0.499),
-                      "Poisson ratio of the FEM reference and of the fitted springs. The "
-                      "paper's springs contract with their own effective ratio whatever is "
-                      "asked here (doc/accuracy.md)."));
+    prm.declare_entry(
+      "Poisson ratio",
+      "0.25",
+      dealii::Patterns::Double(0.0, 0.499),
+      "Poisson ratio of the FEM reference and of the fitted springs. The "
+      "paper's springs contract with their own effective ratio whatever is "
+      "asked here (doc/accuracy.md).");
     prm.declare_entry(
       "Spring stiffness",
       "paper",
