@@ -1,6 +1,7 @@
 // Constraint plugins: fixed, moving handle, force handle.
 
 #include <lacerta/base/exceptions.h>
+#include <lacerta/base/parameter_utilities.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/scene/constraint.h>
 
@@ -11,32 +12,6 @@ namespace lacerta::scene
 {
   namespace
   {
-    /// Parses a 3-component expression of x, y, z, t; errors name the entry.
-    std::unique_ptr<dealii::FunctionParser<3>>
-    parse_vector_expression(const std::string &entry, const std::string &expression)
-    {
-      auto function = std::make_unique<dealii::FunctionParser<3>>(3);
-      try
-      {
-        function->initialize("x,y,z,t", expression, {}, true);
-        function->value(dealii::Point<3>(), 0);
-      }
-      catch (const dealii::ExceptionBase &e)
-      {
-        std::ostringstream info;
-        e.print_info(info);
-        throw_error("Constraints: cannot use '",
-                    entry,
-                    "' = '",
-                    expression,
-                    "' (three "
-                    "expressions separated by ';' are needed): ",
-                    info.str());
-      }
-      return function;
-    }
-
-
     /**
      * Particles held at their rest positions.
      */
@@ -94,7 +69,8 @@ namespace lacerta::scene
       void
       parse_parameters(dealii::ParameterHandler &prm) override
       {
-        displacement = parse_vector_expression("Displacement", prm.get("Displacement"));
+        displacement =
+          parse_vector_expression("Constraints", "Displacement", prm.get("Displacement"));
       }
 
       bool
@@ -147,7 +123,7 @@ namespace lacerta::scene
       void
       parse_parameters(dealii::ParameterHandler &prm) override
       {
-        force = parse_vector_expression("Force", prm.get("Force"));
+        force = parse_vector_expression("Constraints", "Force", prm.get("Force"));
       }
 
       bool

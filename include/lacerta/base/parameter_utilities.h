@@ -6,7 +6,14 @@
 
 #include <deal.II/base/parameter_handler.h>
 
+namespace dealii
+{
+  template <int dim>
+  class FunctionParser;
+}
+
 #include <array>
+#include <memory>
 #include <string>
 
 namespace lacerta
@@ -25,4 +32,13 @@ namespace lacerta
    */
   std::array<double, 3>
   get_point(const dealii::ParameterHandler &prm, const std::string &name);
+
+  /**
+   * Parses three expressions of x, y, z, t separated by ';' (a vector field that may
+   * vary in time); a bad expression is an Error naming @p section and @p entry.
+   */
+  std::unique_ptr<dealii::FunctionParser<3>>
+  parse_vector_expression(const std::string &section,
+                          const std::string &entry,
+                          const std::string &expression);
 } // namespace lacerta
