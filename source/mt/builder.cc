@@ -370,12 +370,16 @@ namespace lacerta::mt
                && intersection_equals(lv.triangles, lw.triangles, le.triangles);
       }
 
-      /// Largest distance from the input boundary samples around @p v to the boundary
-      /// after collapsing v onto @p w; infinite if a face would turn over.
+      /**
+       * Largest distance from the input boundary samples around @p v to the boundary
+       * after collapsing v onto @p w; infinite if a face would turn over or the
+       * distance exceeds @p give_up (then the exact value does not matter).
+       */
       double
       boundary_error(const std::uint32_t                              v,
                      const std::uint32_t                              w,
-                     const std::vector<std::array<std::uint32_t, 3>> &faces) const
+                     const std::vector<std::array<std::uint32_t, 3>> &faces,
+                     const double                                     give_up) const
       {
         std::vector<std::array<Point3, 3>> after;
         for (const auto &f : faces)
@@ -393,20 +397,27 @@ namespace lacerta::mt
           }
         if (after.empty())
           return std::numeric_limits<double>::infinity();
-        const auto nearest = [&](const Point3 &p)
+        // The distance of a sample only matters if it raises the maximum so far: the
+        // search over faces stops at the first face closer than that.
+        double     error   = 0;
+        const auto include = [&](const Point3 &p)
         {
           double d = std::numeric_limits<double>::infinity();
           for (const auto &f : after)
-            d = std::min(d, point_triangle_distance(p, f[0], f[1], f[2]));
-          return d;
+            if ((d = std::min(d, point_triangle_distance(p, f[0], f[1], f[2]))) <= error)
+              return true;
+          error = d;
+          return error <= give_up;
         };
-        double error = nearest(position[v]);
+        if (!include(position[v]))
+          return std::numeric_limits<double>::infinity();
         for (const auto &f : faces)
         {
           const auto found = face_points.find(key3(f[0], f[1], f[2]));
           if (found != face_points.end())
             for (const std::uint32_t p : found->second)
-              error = std::max(error, nearest(position[p]));
+              if (!include(position[p]))
+                return std::numeric_limits<double>::infinity();
         }
         return error;
       }
@@ -452,7 +463,11 @@ namespace lacerta::mt
                           { return std::find(f.begin(), f.end(), w) != f.end(); });
             if (!on_boundary_edge)
               continue;
-            error = boundary_error(v, w, faces);
+            // A candidate worse than the best so far need not be measured exactly.
+            const double worst = std::isfinite(best.priority)
+                                   ? std::min(max_distance, best.error)
+                                   : max_distance;
+            error              = boundary_error(v, w, faces, worst);
             if (!(error <= max_distance))
               continue;
           }
@@ -467,12 +482,16 @@ namespace lacerta::mt
             best = {w, priority, error};
             continue;
           }
-          double quality = std::numeric_limits<double>::infinity();
+          // A collapse that creates no tetrahedron (every tet of v holds w) would delete
+          // a cap of the object and leave a node the DAG cannot reach: rejected.
+          double       quality   = std::numeric_limits<double>::infinity();
+          unsigned int n_created = 0;
           for (const std::uint32_t t : star[v])
           {
             Tet c;
             if (!collapsed(t, v, w, c))
               continue;
+            ++n_created;
             quality = std::min(quality,
                                tet_quality(position[c[0]],
                                            position[c[1]],
@@ -481,7 +500,7 @@ namespace lacerta::mt
             if (quality < parameters.minimum_quality)
               break;
           }
-          if (quality < parameters.minimum_quality)
+          if (quality < parameters.minimum_quality || n_created == 0)
             continue;
           if (priority == best.priority && quality <= best_quality)
             continue;

@@ -55,8 +55,15 @@ namespace lacerta::mt
                       "': node ",
                       j,
                       " removes a tet it does not own or that a later node inserts.");
-      if (j > 0 && node_vertex[j] >= vertices.size())
-        throw_error("Multi-Triangulation '", source, "': node ", j, " has no vertex.");
+      if (j > 0
+          && (node_vertex[j] >= vertices.size()
+              || coarse_begin[j] == coarse_begin[j + 1]))
+        throw_error(
+          "Multi-Triangulation '",
+          source,
+          "': node ",
+          j,
+          " has no vertex or no coarse tetrahedra (it could never be applied).");
     }
     for (std::size_t t = 0; t < tets.size(); ++t)
     {

@@ -37,7 +37,9 @@ namespace lacerta::physics
     free.assign(rest_positions.size() / 3, 1.0);
     external_force.assign(rest_positions.size(), 0.0);
     springs.clear();
-    rest = rest_positions;
+    // Body forces add their acceleration when initialised again on the new particles.
+    body_acceleration = {{0, 0, 0}};
+    rest              = rest_positions;
   }
 
 

@@ -193,6 +193,13 @@ namespace lacerta
     mt::BuilderParameters parameters;
     parameters.maximum_boundary_error = 0.02;
     const auto mt                     = mt::build_multi_triangulation(input, parameters);
+    EXPECT_NO_THROW(mt.check("rounded box"));
+    {
+      // Boundary decimation must not make the finest level unreachable.
+      mt::Lod finest(mt);
+      finest.extract(*make_query("uniform", {{"Cell size", "0"}}));
+      EXPECT_EQ(active_set(mt, finest), sorted_tets(input.get_tets()));
+    }
     mt::Lod    lod(mt);
     const auto root = lod.make_mesh(lod.active_vertices(), "root");
     // Hausdorff distance from the input boundary vertices to the root's boundary.

@@ -72,8 +72,8 @@ namespace lacerta::physics
 
     /**
      * Replaces every particle by @p rest_positions.size() / 3 free particles at rest
-     * there, without springs or masses (a level of detail change); the caller fills
-     * them and then calls update_force_model().
+     * there, without springs, masses or body acceleration (a level of detail change);
+     * the caller fills them and then calls update_force_model().
      */
     void
     reset(const std::vector<double> &rest_positions);
