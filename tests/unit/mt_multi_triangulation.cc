@@ -179,6 +179,16 @@ namespace lacerta
       query->set_focus({{0.2, 0.3, 0.5}});
       lod.extract(*query);
       const mesh::TetMesh active = lod.make_mesh(lod.active_vertices(), "lod");
+      // Every active tetrahedron satisfies the query: the node that would refine it
+      // does not need applying.
+      for (const auto t : lod.active_tets())
+      {
+        if (const auto d = mt.destroyer[t]; d != mesh::invalid_index)
+        {
+          const auto &b = mt.ball[d];
+          EXPECT_LE(mt.error[d], query->minimum_error({{b[0], b[1], b[2]}}, b[3]));
+        }
+      }
       expect_conforming_box(active);
       EXPECT_NEAR(active.total_volume(), 1.0, 1e-12);
       const auto masses = physics::compute_masses(active, density);
