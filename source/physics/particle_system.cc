@@ -29,6 +29,28 @@ namespace lacerta::physics
 
 
   void
+  ParticleSystem::reset(const std::vector<double> &rest_positions)
+  {
+    position = rest_positions;
+    velocity.assign(rest_positions.size(), 0.0);
+    mass.assign(rest_positions.size() / 3, 0.0);
+    free.assign(rest_positions.size() / 3, 1.0);
+    external_force.assign(rest_positions.size(), 0.0);
+    springs.clear();
+    // Body forces add their acceleration when initialised again on the new particles.
+    body_acceleration = {{0, 0, 0}};
+    rest              = rest_positions;
+  }
+
+
+  void
+  ParticleSystem::update_force_model(const unsigned int n_threads)
+  {
+    forces->initialize(*this, n_threads);
+  }
+
+
+  void
   ParticleSystem::compute_acceleration(const double *x, const double *v, double *a) const
   {
     const auto start = std::chrono::steady_clock::now();

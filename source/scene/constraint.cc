@@ -86,6 +86,7 @@ namespace lacerta::scene
       auto region           = RegionRegistry::create_and_parse(prm.get("Region"), prm);
       constraint->name      = name;
       constraint->particles = region->select(mesh);
+      constraint->region    = std::move(region);
       if (constraint->particles.empty())
         throw_error("Constraints/",
                     name,

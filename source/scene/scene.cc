@@ -1,8 +1,10 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/mesh/mesh_source.h>
+#include <lacerta/mt/multiresolution.h>
 #include <lacerta/physics/assembly.h>
 #include <lacerta/physics/force_model.h>
 #include <lacerta/physics/particle_system.h>
+#include <lacerta/scene/region.h>
 #include <lacerta/scene/scene.h>
 
 #include <algorithm>
@@ -20,23 +22,65 @@ namespace lacerta::scene
     physics::ForceModel::declare_parameters(prm);
     BodyForce::declare_parameters(prm);
     Constraint::declare_parameters(prm, constraint_names);
+    mt::Multiresolution::declare_parameters(prm);
   }
 
 
   Scene::Scene(dealii::ParameterHandler &prm, const unsigned int n_threads)
+      : n_threads(n_threads)
   {
     mesh = mesh::MeshSource::create(prm)->create_mesh();
     mesh.sort_spatially();
     material.parse_parameters(prm);
-
-    std::vector<double> rest(3 * mesh.n_vertices());
-    for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
-      for (unsigned int d = 0; d < 3; ++d)
-        rest[3 * v + d] = mesh.vertex(v)[d];
-    system = std::make_unique<physics::ParticleSystem>(rest);
-
-    system->mass        = physics::compute_masses(mesh, material.density());
     integral_of_density = physics::integrate_over_mesh(mesh, material.density());
+    body_forces         = BodyForce::create(prm);
+    for (auto &force : body_forces)
+      has_varying_loads |= force->varies();
+    constraints = Constraint::create(prm, mesh);
+    for (auto &constraint : constraints)
+      has_varying_loads |= !constraint->prescribes_motion();
+    if (mt::Multiresolution::enabled(prm))
+    {
+      // Constrained particles stay in every level of detail: the scene holds them.
+      std::vector<unsigned int> locked;
+      for (const auto &constraint : constraints)
+        locked.insert(locked.end(),
+                      constraint->particles.begin(),
+                      constraint->particles.end());
+      std::sort(locked.begin(), locked.end());
+      locked.erase(std::unique(locked.begin(), locked.end()), locked.end());
+      multiresolution = std::make_unique<mt::Multiresolution>(prm, mesh, locked);
+    }
+    system = std::make_unique<physics::ParticleSystem>(std::vector<double>());
+    assemble(active_mesh(), 0.0);
+    system->set_force_model(physics::ForceModel::create(prm), n_threads);
+  }
+
+
+  const mesh::TetMesh &
+  Scene::active_mesh() const
+  {
+    return multiresolution ? multiresolution->active_mesh() : mesh;
+  }
+
+
+  void
+  Scene::assemble(const mesh::TetMesh &active, const double t)
+  {
+    std::vector<double> rest(3 * active.n_vertices());
+    for (unsigned int v = 0; v < active.n_vertices(); ++v)
+      for (unsigned int d = 0; d < 3; ++d)
+        rest[3 * v + d] = active.vertex(v)[d];
+    system->reset(rest);
+    system->mass = physics::compute_masses(active, material.density());
+    if (&active != &mesh)
+    {
+      // A coarser boundary covers a slightly different volume; the total mass stays
+      // the integral of the density over the object (Section 3.1).
+      const double total = std::accumulate(system->mass.begin(), system->mass.end(), 0.0);
+      for (double &m : system->mass)
+        m *= integral_of_density / total;
+    }
     for (unsigned int i = 0; i < system->n_particles(); ++i)
       if (!(system->mass[i] > 0) || !std::isfinite(system->mass[i]))
         throw_error("Material/Density: particle ",
@@ -52,10 +96,10 @@ namespace lacerta::scene
                     " kg; the density must be positive and finite on the object.");
 
     system->springs = material.fitted_springs
-                        ? physics::compute_fitted_springs(mesh,
+                        ? physics::compute_fitted_springs(active,
                                                           material.youngs_modulus(),
                                                           material.poisson_ratio)
-                        : physics::compute_springs(mesh, material.youngs_modulus());
+                        : physics::compute_springs(active, material.youngs_modulus());
     for (std::size_t s = 0; s < system->springs.size(); ++s)
       if (!(system->springs.stiffness[s] > 0)
           || !std::isfinite(system->springs.stiffness[s]))
@@ -68,28 +112,41 @@ namespace lacerta::scene
                     " N/m; Young's modulus must be positive and finite on the object.");
     system->mass_damping   = material.mass_damping;
     system->spring_damping = material.spring_damping;
-
-    body_forces = BodyForce::create(prm);
     for (auto &force : body_forces)
-    {
       force->initialize(*system);
-      has_varying_loads |= force->varies();
-    }
-    constraints = Constraint::create(prm, mesh);
     for (auto &constraint : constraints)
-    {
-      constraint->initialize(constraint->particles, *system);
-      has_varying_loads |= !constraint->prescribes_motion();
-    }
-    system->enforce_constraints = [this](const double t, double *x, double *v)
+      constraint->initialize(&active == &mesh ? constraint->particles
+                                              : constraint->region->select(active),
+                             *system);
+    system->enforce_constraints = [this](const double time, double *x, double *v)
     {
       for (const auto &constraint : constraints)
-        constraint->prescribe(t, system->rest_position().data(), x, v);
+        constraint->prescribe(time, system->rest_position().data(), x, v);
     };
-    system->enforce_constraints(0.0, system->position.data(), system->velocity.data());
-    update_loads(0.0);
+    system->enforce_constraints(t, system->position.data(), system->velocity.data());
+    update_loads(t);
+  }
 
-    system->set_force_model(physics::ForceModel::create(prm), n_threads);
+
+  bool
+  Scene::update_level_of_detail(const double       t,
+                                const unsigned int step,
+                                std::ostream      &out)
+  {
+    if (!multiresolution)
+      return false;
+    const std::vector<std::uint32_t> old_vertices = multiresolution->active_vertices();
+    if (!multiresolution->update(t, step))
+      return false;
+    const std::vector<double> old_x = system->position, old_v = system->velocity;
+    assemble(multiresolution->active_mesh(), t);
+    multiresolution->transfer_state(
+      old_vertices, old_x, old_v, system->position, system->velocity);
+    system->enforce_constraints(t, system->position.data(), system->velocity.data());
+    system->update_force_model(n_threads);
+    multiresolution->print_change(
+      out, t, std::accumulate(system->mass.begin(), system->mass.end(), 0.0));
+    return true;
   }
 
 
@@ -113,9 +170,10 @@ namespace lacerta::scene
   void
   Scene::print_summary(std::ostream &out) const
   {
-    const auto   lengths = mesh.edge_length_range();
-    const auto  &k       = system->springs.stiffness;
-    const double total   = std::accumulate(system->mass.begin(), system->mass.end(), 0.0);
+    const mesh::TetMesh &mesh    = active_mesh();
+    const auto           lengths = mesh.edge_length_range();
+    const auto          &k       = system->springs.stiffness;
+    const double total = std::accumulate(system->mass.begin(), system->mass.end(), 0.0);
     out << "Mesh: " << mesh.n_tets() << " tetrahedra, " << mesh.n_vertices()
         << " particles, " << mesh.n_edges() << " springs, "
         << mesh.get_boundary_faces().size() << " boundary faces\n"

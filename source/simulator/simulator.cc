@@ -1,6 +1,7 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/input_path.h>
 #include <lacerta/fem/study.h>
+#include <lacerta/mt/multiresolution.h>
 #include <lacerta/physics/integrator.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/stability.h>
@@ -307,13 +308,15 @@ namespace lacerta
                               dealii::TimerOutput::wall_times);
     physics::ParticleSystem &system = *scene->system;
     scene->print_summary(std::cout);
+    if (scene->multiresolution)
+      scene->multiresolution->print_summary(std::cout, test_mode);
     std::cout << "Integrator: "
               << "time step " << time_step << " s, end time " << end_time << " s\n";
-    const unsigned int substeps = choose_substeps();
+    unsigned int substeps = choose_substeps();
 
     physics::BlowUpMonitor monitor(system, energy_tolerance);
     postprocess::RunState  state;
-    state.mesh     = &scene->mesh;
+    state.mesh     = &scene->active_mesh();
     state.system   = &system;
     state.material = &scene->material;
     state.substeps = substeps;
@@ -371,7 +374,16 @@ namespace lacerta
           integrator->step(system, time + k * h, h);
         }
       }
-      time                = (step == n_steps) ? end_time : time + dt;
+      time = (step == n_steps) ? end_time : time + dt;
+      if (scene->update_level_of_detail(time, step, std::cout))
+      {
+        // Other particles and springs: new scratch space, stability limit and energy
+        // reference.
+        integrator->initialize(system);
+        substeps = state.substeps = choose_substeps();
+        monitor                   = physics::BlowUpMonitor(system, energy_tolerance);
+        state.mesh                = &scene->active_mesh();
+      }
       state.step          = step;
       state.time          = time;
       state.time_step     = dt;

@@ -70,6 +70,18 @@ namespace lacerta::physics
     void
     set_force_model(std::unique_ptr<ForceModel> model, unsigned int n_threads);
 
+    /**
+     * Replaces every particle by @p rest_positions.size() / 3 free particles at rest
+     * there, without springs, masses or body acceleration (a level of detail change);
+     * the caller fills them and then calls update_force_model().
+     */
+    void
+    reset(const std::vector<double> &rest_positions);
+
+    /// Prepares the force model again for the current springs on @p n_threads threads.
+    void
+    update_force_model(unsigned int n_threads);
+
     /// The force model.
     const ForceModel &
     force_model() const

@@ -19,6 +19,8 @@ namespace lacerta::physics
 
 namespace lacerta::scene
 {
+  class Region;
+
   /**
    * A constraint acts on the particles of a region: it prescribes their motion (they
    * are then not free) or applies forces to them.
@@ -71,6 +73,9 @@ namespace lacerta::scene
     std::string name;
     /// The particles the constraint acts on.
     std::vector<unsigned int> particles;
+
+    /// The region that selects them (again on every level of detail).
+    std::shared_ptr<const Region> region;
 
     /**
      * Declares `subsection Constraints` with `Names` and, for every name, its

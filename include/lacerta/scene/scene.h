@@ -17,6 +17,10 @@ namespace lacerta::physics
 {
   class ParticleSystem;
 }
+namespace lacerta::mt
+{
+  class Multiresolution;
+}
 
 namespace lacerta::scene
 {
@@ -44,6 +48,19 @@ namespace lacerta::scene
 
     ~Scene();
 
+    /**
+     * With multiresolution: re-extracts the level of detail if the focus at time @p t
+     * (step @p step) asks for it and, if it changed, rebuilds the particle system on it
+     * with the particles' state carried over (Section 4.2), writing a line to @p out.
+     * Returns whether the particle system changed; without multiresolution, false.
+     */
+    bool
+    update_level_of_detail(double t, unsigned int step, std::ostream &out);
+
+    /// The mesh the particle system lives on: the level of detail, or the mesh.
+    const mesh::TetMesh &
+    active_mesh() const;
+
     /// Recomputes the external forces at time @p t (only if some load varies).
     void
     update_loads(double t);
@@ -64,8 +81,19 @@ namespace lacerta::scene
     std::vector<std::unique_ptr<BodyForce>> body_forces;
     /// ∫σ over the mesh, with the rule of the mass assembly.
     double integral_of_density = 0;
+    /// The multiresolution model, only if the scene enables it.
+    std::unique_ptr<mt::Multiresolution> multiresolution;
 
   private:
-    bool has_varying_loads = false;
+    /**
+     * Sets the particle system up on @p active (the mesh or a level of detail) at time
+     * @p t: masses (scaled to ∫σ over the mesh), springs, damping, body forces,
+     * constraints (their regions select the particles of @p active) and loads.
+     */
+    void
+    assemble(const mesh::TetMesh &active, double t);
+
+    bool         has_varying_loads = false;
+    unsigned int n_threads         = 1;
   };
 } // namespace lacerta::scene

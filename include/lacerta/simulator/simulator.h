@@ -66,6 +66,13 @@ namespace lacerta
     void
     run();
 
+    /// The scene, e.g. to read the final state after run().
+    const scene::Scene &
+    get_scene() const
+    {
+      return *scene;
+    }
+
   private:
     /// Checks the time step against the stability limit; returns the sub-step count.
     unsigned int

@@ -1,0 +1,247 @@
+// lacerta-bench mt: Multi-Triangulation build time and memory, extraction time from
+// scratch and incremental. lacerta-bench lod: LOD simulation error against run time.
+
+#include <lacerta/mesh/triangulation_conversion.h>
+#include <lacerta/mt/builder.h>
+#include <lacerta/mt/lod.h>
+#include <lacerta/mt/lod_query.h>
+#include <lacerta/mt/multiresolution.h>
+#include <lacerta/physics/particle_system.h>
+#include <lacerta/scene/scene.h>
+#include <lacerta/simulator/simulator.h>
+
+#include <deal.II/grid/grid_generator.h>
+#include <deal.II/grid/grid_tools.h>
+#include <deal.II/grid/tria.h>
+
+#include "benchmark_registry.h"
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+#include <sys/resource.h>
+
+namespace lacerta::bench
+{
+  namespace
+  {
+    using Clock = std::chrono::steady_clock;
+
+    double
+    seconds_since(const Clock::time_point start)
+    {
+      return std::chrono::duration<double>(Clock::now() - start).count();
+    }
+
+    /// Peak resident memory of the process (MiB).
+    double
+    peak_memory_mib()
+    {
+      rusage usage{};
+      getrusage(RUSAGE_SELF, &usage);
+      return usage.ru_maxrss / 1024.0;
+    }
+
+    /// The focus query of the scenes: full resolution within @p radius, cells growing
+    /// by half the distance beyond.
+    std::unique_ptr<mt::LodQuery>
+    focus_query(const double radius)
+    {
+      dealii::ParameterHandler prm;
+      mt::LodQueryRegistry::declare_all_in_subsections(prm);
+      prm.enter_subsection("Focus");
+      prm.set("Radius", std::to_string(radius));
+      prm.set("Cell size growth", "0.5");
+      prm.leave_subsection();
+      return mt::LodQueryRegistry::create_and_parse("focus", prm);
+    }
+
+    /**
+     * For every box of n^3 hexahedra (5 tetrahedra each, interior vertices jittered)
+     * given as arguments: MT build time, MT size, peak memory, then for a focus of
+     * radius 0.1 on the unit box: extraction from scratch and incremental
+     * re-extraction after the focus moved by 0.005 (one step of a tool), averaged.
+     */
+    int
+    run_mt(const std::vector<std::string> &arguments)
+    {
+      std::vector<unsigned int> sizes = {13, 27, 59};
+      if (!arguments.empty())
+      {
+        sizes.clear();
+        for (const auto &a : arguments)
+          sizes.push_back(static_cast<unsigned int>(std::stoul(a)));
+      }
+      for (const unsigned int n : sizes)
+      {
+        dealii::Triangulation<3> tria;
+        dealii::GridGenerator::subdivided_hyper_rectangle_with_simplices(
+          tria, {n, n, n}, dealii::Point<3>(), dealii::Point<3>(1, 1, 1));
+        dealii::GridTools::distort_random(0.2, tria, true, 1);
+        mesh::TetMesh mesh = mesh::tet_mesh_from_triangulation(tria, "benchmark box");
+        mesh.sort_spatially();
+        const std::string prefix = "mt." + std::to_string(mesh.n_tets()) + ".";
+        print_figure(prefix + "input_tetrahedra", mesh.n_tets(), "");
+
+        auto       start = Clock::now();
+        const auto mt    = mt::build_multi_triangulation(mesh, mt::BuilderParameters());
+        print_figure(prefix + "build_time", seconds_since(start), "s");
+        print_figure(prefix + "nodes", mt.n_nodes(), "");
+        print_figure(prefix + "mt_tetrahedra", mt.n_tets(), "");
+        print_figure(prefix + "root_tetrahedra", mt.n_fine(0), "");
+        print_figure(prefix + "mt_memory", mt.memory_bytes() / 1048576.0, "MiB");
+        print_figure(prefix + "peak_memory", peak_memory_mib(), "MiB");
+
+        auto query = focus_query(0.1);
+        query->set_focus({{0.1, 0.5, 0.5}});
+        const unsigned int repeats  = 5;
+        double             scratch  = 1e300;
+        std::size_t        lod_size = 0;
+        for (unsigned int r = 0; r < repeats; ++r)
+        {
+          start = Clock::now();
+          mt::Lod lod(mt);
+          lod.extract(*query);
+          scratch  = std::min(scratch, seconds_since(start));
+          lod_size = lod.active_tets().size();
+        }
+        print_figure(prefix + "lod_tetrahedra", lod_size, "");
+        print_figure(prefix + "extraction_from_scratch", 1e3 * scratch, "ms");
+
+        mt::Lod lod(mt);
+        lod.extract(*query);
+        const unsigned int moves   = 160;
+        std::size_t        changed = 0;
+        start                      = Clock::now();
+        for (unsigned int k = 1; k <= moves; ++k)
+        {
+          query->set_focus({{0.1 + 0.005 * k, 0.5, 0.5}});
+          lod.extract(*query);
+          changed += lod.last_change()[0] + lod.last_change()[1];
+        }
+        print_figure(prefix + "incremental_extraction",
+                     1e3 * seconds_since(start) / moves,
+                     "ms");
+        print_figure(prefix + "nodes_changed_per_move", double(changed) / moves, "");
+      }
+      return 0;
+    }
+
+
+    /// One run of a scene; the final positions by MT vertex id and the wall time.
+    struct Run
+    {
+      std::vector<std::uint32_t> vertices;
+      std::vector<double>        position, rest;
+      double                     seconds = 0;
+      std::size_t                tets    = 0;
+    };
+
+
+    Run
+    simulate(const std::string &file, const double end_time, const std::string &settings)
+    {
+      dealii::ParameterHandler prm;
+      Simulator::read_parameters(file, prm);
+      std::istringstream extra(settings);
+      prm.parse_input(extra, "benchmark settings", "", true);
+      prm.set("End time", std::to_string(end_time));
+      prm.set("Test mode", "true");
+      prm.set("Output directory",
+              (std::filesystem::temp_directory_path() / "lacerta-bench-lod").string());
+      prm.enter_subsection("Postprocess");
+      prm.set("List of postprocessors", "");
+      prm.leave_subsection();
+      // The simulator reports on std::cout; the benchmark prints only figures.
+      std::ostringstream quiet;
+      auto *const        saved = std::cout.rdbuf(quiet.rdbuf());
+      Run                run;
+      {
+        Simulator  simulator(prm, file);
+        const auto start = Clock::now();
+        simulator.run();
+        run.seconds       = seconds_since(start);
+        const auto &scene = simulator.get_scene();
+        run.position      = scene.system->position;
+        run.rest          = scene.system->rest_position();
+        run.tets          = scene.active_mesh().n_tets();
+        if (scene.multiresolution)
+          run.vertices = scene.multiresolution->active_vertices();
+        else
+          for (std::uint32_t v = 0; v < scene.mesh.n_vertices(); ++v)
+            run.vertices.push_back(v);
+      }
+      std::cout.rdbuf(saved);
+      return run;
+    }
+
+
+    /**
+     * The LOD speed-up against accuracy: a scene (default prm/square_lod.prm) run to
+     * its end time (default 0.5 s) at full resolution and on levels of detail of
+     * several growths; for each, the wall time and the displacement error at the
+     * particles the LOD keeps, against the full resolution (largest and RMS, relative
+     * to the largest displacement), as `lod.<variant>.<figure>`.
+     */
+    int
+    run_lod(const std::vector<std::string> &arguments)
+    {
+      const std::string file =
+        arguments.size() > 0 ? arguments[0]
+                             : std::string(LACERTA_SOURCE_DIR) + "/prm/square_lod.prm";
+      const double end_time = arguments.size() > 1 ? std::stod(arguments[1]) : 0.5;
+      const Run    full =
+        simulate(file,
+                 end_time,
+                 "subsection Multiresolution\n set Enabled = false\nend\n");
+      double largest = 0;
+      for (std::size_t i = 0; i < full.position.size(); i += 3)
+        largest = std::max(largest,
+                           std::hypot(full.position[i] - full.rest[i],
+                                      full.position[i + 1] - full.rest[i + 1],
+                                      full.position[i + 2] - full.rest[i + 2]));
+      print_figure("lod.full.tetrahedra", full.tets, "");
+      print_figure("lod.full.wall_time", full.seconds, "s");
+      print_figure("lod.full.largest_displacement", largest, "m");
+      for (const std::string growth : {"0.25", "0.5", "1", "2"})
+      {
+        const Run lod   = simulate(file,
+                                 end_time,
+                                 "subsection Multiresolution\n set Enabled = true\n"
+                                   " subsection Focus\n  set Cell size growth = "
+                                   + growth + "\n end\nend\n");
+        double    worst = 0, squares = 0;
+        for (std::size_t i = 0; i < lod.vertices.size(); ++i)
+        {
+          const std::size_t g = lod.vertices[i];
+          const double      e = std::hypot(lod.position[3 * i] - full.position[3 * g],
+                                      lod.position[3 * i + 1] - full.position[3 * g + 1],
+                                      lod.position[3 * i + 2] - full.position[3 * g + 2]);
+          worst               = std::max(worst, e);
+          squares += e * e;
+        }
+        const std::string prefix = "lod.growth_" + growth + ".";
+        print_figure(prefix + "final_tetrahedra", lod.tets, "");
+        print_figure(prefix + "wall_time", lod.seconds, "s");
+        print_figure(prefix + "speed_up", full.seconds / lod.seconds, "");
+        print_figure(prefix + "largest_error", worst / largest, "");
+        print_figure(prefix + "rms_error",
+                     std::sqrt(squares / lod.vertices.size()) / largest,
+                     "");
+      }
+      return 0;
+    }
+  } // namespace
+
+  LACERTA_REGISTER_BENCHMARK("mt",
+                             "MT build time and memory, extraction from scratch and "
+                             "incremental (arguments: box sizes n, n^3 x 5 tetrahedra; "
+                             "default 13 27 59)",
+                             run_mt);
+  LACERTA_REGISTER_BENCHMARK("lod",
+                             "LOD simulation error against run time (arguments: scene, "
+                             "end time; default prm/square_lod.prm 0.5)",
+                             run_lod);
+} // namespace lacerta::bench

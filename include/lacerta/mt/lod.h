@@ -1,0 +1,129 @@
+/**
+ * @file
+ * A level of detail of a Multi-Triangulation: extraction by a query, incremental
+ * update, and the location of new vertices in the previous level (Section 4.2).
+ */
+#pragma once
+
+#include <lacerta/mesh/tet_mesh.h>
+#include <lacerta/mt/multi_triangulation.h>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace lacerta::mt
+{
+  class LodQuery;
+
+  /**
+   * The current level of detail: the set of applied nodes (closed under parents) and
+   * the tetrahedra it selects.
+   *
+   * Node j must be applied when its error exceeds the smallest error the query allows
+   * over its ball. Errors never decrease and balls never shrink from a node to its
+   * parents, so this predicate is monotone along the DAG; the applied set is then
+   * exactly the nodes that satisfy it, the smallest closed set whose tetrahedra all
+   * satisfy the query, i.e. the conforming mesh with the fewest tetrahedra. The same
+   * set comes out whether it is extracted from the root or updated from any previous
+   * level of detail.
+   */
+  class Lod
+  {
+  public:
+    /// Starts at the root (the coarsest mesh).
+    explicit Lod(const MultiTriangulation &mt);
+
+    /**
+     * Updates to the level of detail @p query asks for, starting from the current one.
+     * The work is one test per active tetrahedron plus the nodes applied or undone:
+     * proportional to the current mesh and the change, not to the MT.
+     * Returns whether anything changed.
+     */
+    bool
+    extract(const LodQuery &query);
+
+    /// The active tetrahedra (ids into the MT), in no particular order.
+    const std::vector<std::uint32_t> &
+    active_tets() const
+    {
+      return active;
+    }
+
+    /// Whether tet @p t is active.
+    bool
+    is_active(const std::uint32_t t) const
+    {
+      return position[t] != mesh::invalid_index;
+    }
+
+    /// Whether node @p j is applied.
+    bool
+    is_applied(const std::uint32_t j) const
+    {
+      return applied[j] != 0;
+    }
+
+    /// Whether node @p j was applied before the last extract().
+    bool
+    was_applied(const std::uint32_t j) const
+    {
+      return (applied[j] != 0) != (changed[j] != 0);
+    }
+
+    /// Number of nodes applied and undone by the last extract().
+    std::array<unsigned int, 2>
+    last_change() const
+    {
+      return {{n_last_applied, n_last_undone}};
+    }
+
+    /// The vertices of the active tetrahedra, sorted.
+    std::vector<std::uint32_t>
+    active_vertices() const;
+
+    /**
+     * The active mesh with its vertices numbered in the order of @p vertices (which
+     * must be active_vertices()); @p name is used in messages.
+     */
+    mesh::TetMesh
+    make_mesh(const std::vector<std::uint32_t> &vertices, const std::string &name) const;
+
+    /**
+     * For a vertex @p v that the last extract() brought in, the tetrahedron of the
+     * previous level of detail that contains its rest position, found by walking up
+     * the MT from the fragment that removed it (Section 4.2), and v's barycentric
+     * coordinates in it (not clamped: slightly negative ones mean that v lies outside
+     * the previous, coarser boundary).
+     */
+    std::pair<std::uint32_t, std::array<double, 4>>
+    locate_in_previous(std::uint32_t v) const;
+
+  private:
+    void
+    activate(std::uint32_t t);
+
+    void
+    deactivate(std::uint32_t t);
+
+    bool
+    needs(std::uint32_t j, const LodQuery &query);
+
+    void
+    toggle(std::uint32_t j);
+
+    const MultiTriangulation  *mt;
+    std::vector<std::uint8_t>  applied;
+    std::vector<std::uint8_t>  changed;
+    std::vector<std::uint32_t> changed_list;
+    std::vector<std::uint32_t> position;
+    std::vector<std::uint32_t> active;
+    std::vector<std::uint32_t> active_coarse;
+    std::vector<std::uint32_t> active_fine;
+    std::vector<std::uint32_t> need_stamp;
+    std::vector<std::uint8_t>  need_value;
+    std::uint32_t              stamp          = 0;
+    unsigned int               n_last_applied = 0;
+    unsigned int               n_last_undone  = 0;
+  };
+} // namespace lacerta::mt

@@ -1,0 +1,120 @@
+/**
+ * @file
+ * The Multi-Triangulation (Section 4): the fragments of a decimation and their DAG.
+ */
+#pragma once
+
+#include <lacerta/mesh/tet_mesh.h>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace lacerta::mt
+{
+  /**
+   * A Multi-Triangulation built by decimation, stored in the refinement direction.
+   *
+   * Node 0 is the root: it inserts the tetrahedra of the fully decimated mesh. Every
+   * other node j undoes one half-edge collapse: it removes the tetrahedra the collapse
+   * created (its coarse fragment, coarse_tets(j)) and inserts the ones the collapse
+   * removed (its fine fragment, the tets [fine_begin[j], fine_begin[j+1])), which brings
+   * back vertex node_vertex[j]. Node j depends on the nodes that insert its coarse
+   * tetrahedra (its parents), which always have smaller indices, so node order is a
+   * topological order of the DAG. A set of applied nodes closed under parents gives a
+   * conforming mesh: the tets whose creator is applied and whose destroyer is not.
+   *
+   * Vertices are those of the input mesh with their ids: decimation removes vertices and
+   * never invents any, so particles keep their vertex id at every level of detail.
+   */
+  class MultiTriangulation
+  {
+  public:
+    /// Rest positions of all vertices (the input mesh's).
+    std::vector<mesh::Point3> vertices;
+    /// Every tetrahedron of every fragment, grouped by the node that inserts it.
+    std::vector<mesh::Tet> tets;
+    /// Per tet: the node that inserts it.
+    std::vector<std::uint32_t> creator;
+    /// Per tet: the node that removes it, mesh::invalid_index for input tetrahedra.
+    std::vector<std::uint32_t> destroyer;
+    /// Per node (plus one): the first tet it inserts.
+    std::vector<std::uint32_t> fine_begin;
+    /// Per node (plus one): where its coarse tets start in coarse_list.
+    std::vector<std::uint32_t> coarse_begin;
+    /// The coarse tets of all nodes, node after node.
+    std::vector<std::uint32_t> coarse_list;
+    /// Per node: the vertex it inserts (invalid_index for the root).
+    std::vector<std::uint32_t> node_vertex;
+    /// Per vertex: the node that inserts it (0 for the vertices of the root mesh).
+    std::vector<std::uint32_t> vertex_node;
+    /**
+     * Per node: its error, the average volume of its coarse fragment (Section 4.1),
+     * raised to the largest error of its descendants so that it never decreases from
+     * a node to its parents.
+     */
+    std::vector<double> error;
+    /**
+     * Per node: a ball (x, y, z, radius) that contains its fragments and the balls of
+     * all its descendants, so that a query's smallest allowed error over the ball of a
+     * node is never above that over the balls of its descendants.
+     */
+    std::vector<std::array<double, 4>> ball;
+
+    /// Number of nodes (the root included).
+    unsigned int
+    n_nodes() const
+    {
+      return static_cast<unsigned int>(node_vertex.size());
+    }
+
+    /// Number of tetrahedra over all fragments.
+    unsigned int
+    n_tets() const
+    {
+      return static_cast<unsigned int>(tets.size());
+    }
+
+    /// Number of vertices.
+    unsigned int
+    n_vertices() const
+    {
+      return static_cast<unsigned int>(vertices.size());
+    }
+
+    /// Number of tetrahedra node @p j inserts.
+    unsigned int
+    n_fine(const unsigned int j) const
+    {
+      return fine_begin[j + 1] - fine_begin[j];
+    }
+
+    /// Number of tetrahedra node @p j removes.
+    unsigned int
+    n_coarse(const unsigned int j) const
+    {
+      return coarse_begin[j + 1] - coarse_begin[j];
+    }
+
+    /// Bytes held by the arrays.
+    std::size_t
+    memory_bytes() const;
+
+    /**
+     * Barycentric coordinates of point @p p in tet @p t (rest configuration); all are
+     * >= 0 when p lies in the tet.
+     */
+    std::array<double, 4>
+    barycentric(unsigned int t, const mesh::Point3 &p) const;
+
+    /**
+     * Checks the structure (index ranges, parents before children, every tet removed
+     * by at most its destroyer, positive volumes); throws a lacerta::Error naming
+     * @p source otherwise. Used after loading a file.
+     */
+    void
+    check(const std::string &source) const;
+  };
+} // namespace lacerta::mt

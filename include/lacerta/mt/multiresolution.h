@@ -1,0 +1,131 @@
+/**
+ * @file
+ * Multiresolution in a scene: the MT built or loaded, the level of detail following
+ * the tool, and the state of the particles carried from one level to the next.
+ */
+#pragma once
+
+#include <lacerta/mesh/tet_mesh.h>
+#include <lacerta/mt/lod.h>
+#include <lacerta/mt/lod_query.h>
+#include <lacerta/mt/multi_triangulation.h>
+#include <lacerta/mt/storage.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <cstdint>
+#include <iosfwd>
+#include <memory>
+#include <vector>
+
+namespace dealii
+{
+  template <int dim>
+  class FunctionParser;
+}
+
+namespace lacerta::mt
+{
+  /**
+   * Owns the MT of a scene's mesh (from the cache or built), the current level of
+   * detail and its mesh, and decides when to re-extract: when the focus (a point moving
+   * along `Focus path`) has moved more than `Re-extraction distance` since the last
+   * extraction, or every `Re-extraction interval` steps. Only scenes with
+   * `Multiresolution/Enabled = true` create one.
+   */
+  class Multiresolution
+  {
+  public:
+    /// Declares `subsection Multiresolution`.
+    static void
+    declare_parameters(dealii::ParameterHandler &prm);
+
+    /// Whether @p prm enables multiresolution.
+    static bool
+    enabled(dealii::ParameterHandler &prm);
+
+    /**
+     * Builds or loads the MT of @p mesh (whose @p locked vertices are never removed)
+     * and extracts the level of detail for the focus at time 0.
+     */
+    Multiresolution(dealii::ParameterHandler        &prm,
+                    const mesh::TetMesh             &mesh,
+                    const std::vector<unsigned int> &locked);
+
+    ~Multiresolution();
+
+    /**
+     * Re-extracts if the focus at time @p time (step @p step) has moved far enough or
+     * the interval has passed; returns whether the level of detail changed.
+     */
+    bool
+    update(double time, unsigned int step);
+
+    /// The mesh of the current level of detail (vertices numbered compactly).
+    const mesh::TetMesh &
+    active_mesh() const
+    {
+      return mesh;
+    }
+
+    /// The MT vertex id of every vertex of active_mesh(), increasing.
+    const std::vector<std::uint32_t> &
+    active_vertices() const
+    {
+      return vertices;
+    }
+
+    /**
+     * Fills positions @p x and velocities @p v (3 per vertex of active_mesh()) from the
+     * state @p old_x, @p old_v of the previous level of detail, whose vertices were
+     * @p old_vertices: vertices kept keep their state, new ones get the state
+     * interpolated in the previous level's tetrahedron that contains them
+     * (Lod::locate_in_previous), with barycentric coordinates clamped to the
+     * tetrahedron.
+     */
+    void
+    transfer_state(const std::vector<std::uint32_t> &old_vertices,
+                   const std::vector<double>        &old_x,
+                   const std::vector<double>        &old_v,
+                   std::vector<double>              &x,
+                   std::vector<double>              &v);
+
+    /// Writes the MT's size, its build or load and the current level of detail.
+    void
+    print_summary(std::ostream &out, bool test_mode) const;
+
+    /// Writes one line about the last change of the level of detail at @p time, with
+    /// the particle system's @p total_mass.
+    void
+    print_change(std::ostream &out, double time, double total_mass) const;
+
+    /// The Multi-Triangulation.
+    const MultiTriangulation &
+    multi_triangulation() const
+    {
+      return mt;
+    }
+
+    /// The focus at time @p time.
+    mesh::Point3
+    focus(double time) const;
+
+  private:
+    /// Rebuilds the mesh and the vertex list from the Lod.
+    void
+    make_active_mesh();
+
+    MultiTriangulation                         mt;
+    CacheReport                                cache;
+    std::unique_ptr<Lod>                       lod;
+    std::unique_ptr<LodQuery>                  query;
+    std::unique_ptr<dealii::FunctionParser<3>> path;
+    double                                     distance = 0;
+    unsigned int                               interval = 1;
+    mesh::Point3                               last_focus{};
+    unsigned int                               last_step = 0;
+    mesh::TetMesh                              mesh;
+    std::vector<std::uint32_t>                 vertices;
+    std::size_t                                n_kept = 0, n_new = 0;
+  };
+} // namespace lacerta::mt

@@ -1,0 +1,771 @@
+#include <lacerta/base/exceptions.h>
+#include <lacerta/mt/builder.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <queue>
+#include <unordered_map>
+
+namespace lacerta::mt
+{
+  namespace
+  {
+    using mesh::Point3;
+    using mesh::Tet;
+    constexpr std::uint32_t none = mesh::invalid_index;
+
+    Point3
+    minus(const Point3 &a, const Point3 &b)
+    {
+      return {{a[0] - b[0], a[1] - b[1], a[2] - b[2]}};
+    }
+
+    double
+    dot(const Point3 &a, const Point3 &b)
+    {
+      return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    }
+
+    Point3
+    cross(const Point3 &a, const Point3 &b)
+    {
+      return {{a[1] * b[2] - a[2] * b[1],
+               a[2] * b[0] - a[0] * b[2],
+               a[0] * b[1] - a[1] * b[0]}};
+    }
+
+    double
+    distance(const Point3 &a, const Point3 &b)
+    {
+      const Point3 d = minus(a, b);
+      return std::sqrt(dot(d, d));
+    }
+
+    /// Distance from @p p to the triangle (a, b, c), by its closest point (Ericson).
+    double
+    point_triangle_distance(const Point3 &p,
+                            const Point3 &a,
+                            const Point3 &b,
+                            const Point3 &c)
+    {
+      const Point3 ab = minus(b, a), ac = minus(c, a), ap = minus(p, a);
+      const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+      if (d1 <= 0 && d2 <= 0)
+        return distance(p, a);
+      const Point3 bp = minus(p, b);
+      const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+      if (d3 >= 0 && d4 <= d3)
+        return distance(p, b);
+      const double vc = d1 * d4 - d3 * d2;
+      const auto   on = [&](const Point3 &o, const Point3 &e, const double s) {
+        return distance(p, {{o[0] + s * e[0], o[1] + s * e[1], o[2] + s * e[2]}});
+      };
+      if (vc <= 0 && d1 >= 0 && d3 <= 0)
+        return on(a, ab, d1 / (d1 - d3));
+      const Point3 cp = minus(p, c);
+      const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+      if (d6 >= 0 && d5 <= d6)
+        return distance(p, c);
+      const double vb = d5 * d2 - d1 * d6;
+      if (vb <= 0 && d2 >= 0 && d6 <= 0)
+        return on(a, ac, d2 / (d2 - d6));
+      const double va = d3 * d6 - d5 * d4;
+      if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+        return on(b, minus(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6)));
+      const double denominator = 1 / (va + vb + vc);
+      const double v = vb * denominator, w = vc * denominator;
+      return distance(p,
+                      {{a[0] + ab[0] * v + ac[0] * w,
+                        a[1] + ab[1] * v + ac[1] * w,
+                        a[2] + ab[2] * v + ac[2] * w}});
+    }
+
+    /// Unit normal of (a, b, c); zero if degenerate.
+    Point3
+    unit_normal(const Point3 &a, const Point3 &b, const Point3 &c)
+    {
+      Point3       n      = cross(minus(b, a), minus(c, a));
+      const double length = std::sqrt(dot(n, n));
+      if (length > 0)
+        for (double &x : n)
+          x /= length;
+      return n;
+    }
+
+    /// Key of a set of up to three ids below 2^21 (order-independent).
+    std::uint64_t
+    key3(std::uint32_t a, std::uint32_t b, std::uint32_t c)
+    {
+      if (a > b)
+        std::swap(a, b);
+      if (b > c)
+        std::swap(b, c);
+      if (a > b)
+        std::swap(a, b);
+      return (std::uint64_t(a) << 42) | (std::uint64_t(b) << 21) | c;
+    }
+
+    std::uint64_t
+    key2(std::uint32_t a, std::uint32_t b)
+    {
+      return a < b ? (std::uint64_t(a) << 32) | b : (std::uint64_t(b) << 32) | a;
+    }
+
+    /// Sorts and removes repeated entries.
+    template <typename T>
+    void
+    sort_unique(std::vector<T> &list)
+    {
+      std::sort(list.begin(), list.end());
+      list.erase(std::unique(list.begin(), list.end()), list.end());
+    }
+
+    /// Whether the sorted lists @p a and @p b have exactly the common entries @p c.
+    template <typename T>
+    bool
+    intersection_equals(const std::vector<T> &a,
+                        const std::vector<T> &b,
+                        const std::vector<T> &c)
+    {
+      std::vector<T> common;
+      std::set_intersection(
+        a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(common));
+      return common == c;
+    }
+
+    /// A candidate collapse of a vertex.
+    struct Collapse
+    {
+      std::uint32_t target   = none;
+      double        priority = std::numeric_limits<double>::infinity();
+      double        error    = 0;
+    };
+
+    /**
+     * The decimation: a mesh that loses one vertex at a time, with the record of every
+     * collapse.
+     */
+    class Decimator
+    {
+    public:
+      Decimator(const mesh::TetMesh             &mesh,
+                const BuilderParameters         &parameters,
+                const std::vector<unsigned int> &locked_vertices)
+          : parameters(parameters)
+          , position(mesh.get_vertices())
+          , tets(mesh.get_tets())
+          , alive(tets.size(), 1)
+          , star(position.size())
+          , removed(position.size(), 0)
+          , locked(position.size(), 0)
+          , boundary(position.size(), 0)
+          , stamp(position.size(), 0)
+          , ghost(static_cast<std::uint32_t>(position.size()))
+      {
+        if (position.size() + 1 >= (std::size_t(1) << 21))
+          throw_error("Multiresolution: the mesh '",
+                      mesh.source(),
+                      "' has ",
+                      position.size(),
+                      " vertices; the builder handles fewer than 2^21.");
+        for (std::uint32_t t = 0; t < tets.size(); ++t)
+          for (const unsigned int v : tets[t])
+            star[v].push_back(t);
+        for (const unsigned int v : locked_vertices)
+          locked.at(v) = 1;
+        Point3 low = position.empty() ? Point3{} : position[0], high = low;
+        for (std::uint32_t v = 0; v < position.size(); ++v)
+        {
+          boundary[v] = mesh.is_boundary_vertex(v);
+          for (unsigned int d = 0; d < 3; ++d)
+          {
+            low[d]  = std::min(low[d], position[v][d]);
+            high[d] = std::max(high[d], position[v][d]);
+          }
+        }
+        max_distance = parameters.maximum_boundary_error * distance(low, high);
+        // Every input boundary vertex is a sample of the input boundary; it starts on the
+        // faces around it (the first one is enough: its distance is zero).
+        for (const auto &face : mesh.get_boundary_faces())
+        {
+          const Tet  &t = tets[face.tet];
+          const auto &l = mesh::TetMesh::face_vertices[face.face];
+          face_points[key3(t[l[0]], t[l[1]], t[l[2]])];
+        }
+      }
+
+      void
+      run()
+      {
+        for (std::uint32_t v = 0; v < position.size(); ++v)
+          schedule(v);
+        while (!queue.empty())
+        {
+          const Entry entry = queue.top();
+          queue.pop();
+          const std::uint32_t v = entry.vertex;
+          if (removed[v] || entry.stamp != stamp[v])
+            continue;
+          const Collapse best = find_collapse(v, true);
+          if (best.target == none)
+            continue;
+          if (best.priority > entry.priority * (1 + 1e-12) && !queue.empty()
+              && best.priority > queue.top().priority)
+          {
+            queue.push({best.priority, v, ++stamp[v]});
+            continue;
+          }
+          collapse(v, best.target);
+        }
+      }
+
+      MultiTriangulation
+      assemble() const;
+
+    private:
+      struct Entry
+      {
+        double        priority;
+        std::uint32_t vertex;
+        std::uint32_t stamp;
+        bool
+        operator<(const Entry &other) const
+        {
+          // std::priority_queue pops the largest: the smallest priority must compare
+          // largest.
+          return priority > other.priority
+                 || (priority == other.priority && vertex > other.vertex);
+        }
+      };
+
+      /// Outward oriented boundary faces around @p v, from its star.
+      std::vector<std::array<std::uint32_t, 3>>
+      boundary_faces(const std::uint32_t v) const
+      {
+        std::vector<std::pair<std::uint64_t, std::array<std::uint32_t, 3>>> faces;
+        for (const std::uint32_t t : star[v])
+          for (unsigned int f = 0; f < 4; ++f)
+            if (tets[t][f] != v)
+            {
+              const auto                        &l    = mesh::TetMesh::face_vertices[f];
+              const std::array<std::uint32_t, 3> face = {
+                {tets[t][l[0]], tets[t][l[1]], tets[t][l[2]]}};
+              faces.push_back({key3(face[0], face[1], face[2]), face});
+            }
+        std::sort(faces.begin(),
+                  faces.end(),
+                  [](const auto &a, const auto &b) { return a.first < b.first; });
+        std::vector<std::array<std::uint32_t, 3>> result;
+        for (std::size_t i = 0; i < faces.size();)
+        {
+          std::size_t j = i;
+          while (j < faces.size() && faces[j].first == faces[i].first)
+            ++j;
+          if (j - i == 1)
+            result.push_back(faces[i].second);
+          i = j;
+        }
+        return result;
+      }
+
+      /**
+       * Tet @p t after collapsing @p v onto @p w, in @p result; false if t contains
+       * the edge vw and disappears.
+       */
+      bool
+      collapsed(const std::uint32_t t,
+                const std::uint32_t v,
+                const std::uint32_t w,
+                Tet                &result) const
+      {
+        result = tets[t];
+        if (std::find(result.begin(), result.end(), w) != result.end())
+          return false;
+        std::replace(result.begin(),
+                     result.end(),
+                     static_cast<unsigned int>(v),
+                     static_cast<unsigned int>(w));
+        return true;
+      }
+
+      /// The vertices sharing a tetrahedron with @p v.
+      std::vector<std::uint32_t>
+      neighbours(const std::uint32_t v) const
+      {
+        std::vector<std::uint32_t> list;
+        for (const std::uint32_t t : star[v])
+          for (const unsigned int u : tets[t])
+            if (u != v)
+              list.push_back(u);
+        sort_unique(list);
+        return list;
+      }
+
+      /**
+       * The link condition Lk(v) ∩ Lk(w) = Lk(vw) on the mesh closed by a ghost vertex
+       * joined to every boundary face: it keeps the mesh a manifold and the boundary's
+       * topology unchanged.
+       */
+      bool
+      link_condition(const std::uint32_t v, const std::uint32_t w) const
+      {
+        std::vector<std::array<std::uint32_t, 4>> cells_v, cells_w;
+        const auto                                gather =
+          [&](const std::uint32_t u, std::vector<std::array<std::uint32_t, 4>> &cells)
+        {
+          for (const std::uint32_t t : star[u])
+            cells.push_back(tets[t]);
+          for (const auto &f : boundary_faces(u))
+            cells.push_back({{ghost, f[0], f[1], f[2]}});
+        };
+        gather(v, cells_v);
+        gather(w, cells_w);
+        struct Link
+        {
+          std::vector<std::uint64_t> vertices, edges, triangles;
+        };
+        const auto link = [](const std::vector<std::array<std::uint32_t, 4>> &cells,
+                             const std::uint32_t                              u)
+        {
+          Link l;
+          for (const auto &c : cells)
+          {
+            std::array<std::uint32_t, 3> o{};
+            unsigned int                 n = 0;
+            for (const std::uint32_t x : c)
+              if (x != u)
+                o[n++] = x;
+            l.triangles.push_back(key3(o[0], o[1], o[2]));
+            for (unsigned int i = 0; i < 3; ++i)
+            {
+              l.vertices.push_back(o[i]);
+              l.edges.push_back(key2(o[i], o[(i + 1) % 3]));
+            }
+          }
+          sort_unique(l.vertices);
+          sort_unique(l.edges);
+          sort_unique(l.triangles);
+          return l;
+        };
+        const Link lv = link(cells_v, v), lw = link(cells_w, w);
+        Link       le;
+        for (const auto &c : cells_v)
+          if (std::find(c.begin(), c.end(), w) != c.end())
+          {
+            std::array<std::uint32_t, 2> o{};
+            unsigned int                 n = 0;
+            for (const std::uint32_t x : c)
+              if (x != v && x != w)
+                o[n++] = x;
+            le.vertices.push_back(o[0]);
+            le.vertices.push_back(o[1]);
+            le.edges.push_back(key2(o[0], o[1]));
+          }
+        sort_unique(le.vertices);
+        sort_unique(le.edges);
+        return intersection_equals(lv.vertices, lw.vertices, le.vertices)
+               && intersection_equals(lv.edges, lw.edges, le.edges)
+               && intersection_equals(lv.triangles, lw.triangles, le.triangles);
+      }
+
+      /**
+       * Largest distance from the input boundary samples around @p v to the boundary
+       * after collapsing v onto @p w; infinite if a face would turn over or the
+       * distance exceeds @p give_up (then the exact value does not matter).
+       */
+      double
+      boundary_error(const std::uint32_t                              v,
+                     const std::uint32_t                              w,
+                     const std::vector<std::array<std::uint32_t, 3>> &faces,
+                     const double                                     give_up) const
+      {
+        std::vector<std::array<Point3, 3>> after;
+        for (const auto &f : faces)
+          if (std::find(f.begin(), f.end(), w) == f.end())
+          {
+            std::array<Point3, 3> moved;
+            for (unsigned int i = 0; i < 3; ++i)
+              moved[i] = position[f[i] == v ? w : f[i]];
+            const Point3 old_normal =
+              unit_normal(position[f[0]], position[f[1]], position[f[2]]);
+            const Point3 new_normal = unit_normal(moved[0], moved[1], moved[2]);
+            if (dot(old_normal, new_normal) < 0.5)
+              return std::numeric_limits<double>::infinity();
+            after.push_back(moved);
+          }
+        if (after.empty())
+          return std::numeric_limits<double>::infinity();
+        // The distance of a sample only matters if it raises the maximum so far: the
+        // search over faces stops at the first face closer than that.
+        double     error   = 0;
+        const auto include = [&](const Point3 &p)
+        {
+          double d = std::numeric_limits<double>::infinity();
+          for (const auto &f : after)
+            if ((d = std::min(d, point_triangle_distance(p, f[0], f[1], f[2]))) <= error)
+              return true;
+          error = d;
+          return error <= give_up;
+        };
+        if (!include(position[v]))
+          return std::numeric_limits<double>::infinity();
+        for (const auto &f : faces)
+        {
+          const auto found = face_points.find(key3(f[0], f[1], f[2]));
+          if (found != face_points.end())
+            for (const std::uint32_t p : found->second)
+              if (!include(position[p]))
+                return std::numeric_limits<double>::infinity();
+        }
+        return error;
+      }
+
+      /**
+       * The best valid collapse of @p v and its priority. With @p full, every check is
+       * made; without, only the boundary error (for the priority of a queue entry).
+       */
+      Collapse
+      find_collapse(const std::uint32_t v, const bool full) const
+      {
+        Collapse best;
+        if (locked[v] || removed[v] || star[v].empty())
+          return best;
+        double volume = 0;
+        for (const std::uint32_t t : star[v])
+          volume += mesh::signed_volume(position[tets[t][0]],
+                                        position[tets[t][1]],
+                                        position[tets[t][2]],
+                                        position[tets[t][3]]);
+        volume /= star[v].size();
+        const std::vector<std::uint32_t> around    = neighbours(v);
+        double                           mean_edge = 0;
+        for (const std::uint32_t u : around)
+          mean_edge += distance(position[u], position[v]);
+        mean_edge /= around.size();
+
+        std::vector<std::array<std::uint32_t, 3>> faces;
+        if (boundary[v])
+          faces = boundary_faces(v);
+        double best_quality = -1;
+        for (const std::uint32_t w : around)
+        {
+          double error = 0;
+          if (boundary[v])
+          {
+            // A boundary vertex may only slide along a boundary edge onto a boundary
+            // vertex.
+            const bool on_boundary_edge =
+              std::any_of(faces.begin(),
+                          faces.end(),
+                          [w](const auto &f)
+                          { return std::find(f.begin(), f.end(), w) != f.end(); });
+            if (!on_boundary_edge)
+              continue;
+            // A candidate worse than the best so far need not be measured exactly.
+            const double worst = std::isfinite(best.priority)
+                                   ? std::min(max_distance, best.error)
+                                   : max_distance;
+            error              = boundary_error(v, w, faces, worst);
+            if (!(error <= max_distance))
+              continue;
+          }
+          const double priority =
+            boundary[v]
+              ? volume * (1 + parameters.boundary_error_weight * error / mean_edge)
+              : volume;
+          if (priority > best.priority)
+            continue;
+          if (!full)
+          {
+            best = {w, priority, error};
+            continue;
+          }
+          // A collapse that creates no tetrahedron (every tet of v holds w) would delete
+          // a cap of the object and leave a node the DAG cannot reach: rejected.
+          double       quality   = std::numeric_limits<double>::infinity();
+          unsigned int n_created = 0;
+          for (const std::uint32_t t : star[v])
+          {
+            Tet c;
+            if (!collapsed(t, v, w, c))
+              continue;
+            ++n_created;
+            quality = std::min(quality,
+                               tet_quality(position[c[0]],
+                                           position[c[1]],
+                                           position[c[2]],
+                                           position[c[3]]));
+            if (quality < parameters.minimum_quality)
+              break;
+          }
+          if (quality < parameters.minimum_quality || n_created == 0)
+            continue;
+          if (priority == best.priority && quality <= best_quality)
+            continue;
+          if (!link_condition(v, w))
+            continue;
+          best         = {w, priority, error};
+          best_quality = quality;
+        }
+        return best;
+      }
+
+      void
+      schedule(const std::uint32_t v)
+      {
+        ++stamp[v];
+        const Collapse c = find_collapse(v, false);
+        if (c.target != none)
+          queue.push({c.priority, v, stamp[v]});
+      }
+
+      void
+      collapse(const std::uint32_t v, const std::uint32_t w)
+      {
+        if (boundary[v])
+        {
+          // The samples around v go to their nearest face of the new boundary.
+          const auto                 faces = boundary_faces(v);
+          std::vector<std::uint32_t> samples;
+          if (v < n_input_samples())
+            samples.push_back(v);
+          std::vector<std::array<std::uint32_t, 3>> after;
+          for (const auto &f : faces)
+          {
+            const auto found = face_points.find(key3(f[0], f[1], f[2]));
+            if (found != face_points.end())
+            {
+              samples.insert(samples.end(), found->second.begin(), found->second.end());
+              face_points.erase(found);
+            }
+            if (std::find(f.begin(), f.end(), w) == f.end())
+            {
+              std::array<std::uint32_t, 3> g = f;
+              std::replace(g.begin(), g.end(), v, w);
+              after.push_back(g);
+              face_points[key3(g[0], g[1], g[2])];
+            }
+          }
+          for (const std::uint32_t p : samples)
+          {
+            double      nearest = std::numeric_limits<double>::infinity();
+            std::size_t which   = 0;
+            for (std::size_t i = 0; i < after.size(); ++i)
+            {
+              const double d = point_triangle_distance(position[p],
+                                                       position[after[i][0]],
+                                                       position[after[i][1]],
+                                                       position[after[i][2]]);
+              if (d < nearest)
+              {
+                nearest = d;
+                which   = i;
+              }
+            }
+            face_points[key3(after[which][0], after[which][1], after[which][2])]
+              .push_back(p);
+          }
+        }
+
+        const std::vector<std::uint32_t> old_star = star[v];
+        std::vector<std::uint32_t>       affected;
+        removed_begin.push_back(static_cast<std::uint32_t>(removed_list.size()));
+        created_begin.push_back(static_cast<std::uint32_t>(created_list.size()));
+        for (const std::uint32_t t : old_star)
+        {
+          alive[t] = 0;
+          removed_list.push_back(t);
+          for (const unsigned int u : tets[t])
+            if (u != v)
+            {
+              auto &s = star[u];
+              s.erase(std::find(s.begin(), s.end(), t));
+              affected.push_back(u);
+            }
+        }
+        for (const std::uint32_t t : old_star)
+        {
+          Tet c;
+          if (!collapsed(t, v, w, c))
+            continue;
+          const std::uint32_t id = static_cast<std::uint32_t>(tets.size());
+          tets.push_back(c);
+          alive.push_back(1);
+          created_list.push_back(id);
+          for (const unsigned int u : c)
+            star[u].push_back(id);
+        }
+        star[v].clear();
+        removed[v] = 1;
+        removed_vertex.push_back(v);
+        sort_unique(affected);
+        for (const std::uint32_t u : affected)
+          if (!removed[u])
+            schedule(u);
+      }
+
+      std::uint32_t
+      n_input_samples() const
+      {
+        return ghost;
+      }
+
+      const BuilderParameters                &parameters;
+      std::vector<Point3>                     position;
+      std::vector<Tet>                        tets;
+      std::vector<std::uint8_t>               alive;
+      std::vector<std::vector<std::uint32_t>> star;
+      std::vector<std::uint8_t>               removed, locked, boundary;
+      std::vector<std::uint32_t>              stamp;
+      std::uint32_t                           ghost;
+      double                                  max_distance = 0;
+      std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> face_points;
+      std::priority_queue<Entry>                                    queue;
+      // The record: collapse k removed vertex removed_vertex[k], removed the tets from
+      // removed_begin[k] and created those from created_begin[k].
+      std::vector<std::uint32_t> removed_vertex, removed_begin, removed_list,
+        created_begin, created_list;
+    };
+
+
+    MultiTriangulation
+    Decimator::assemble() const
+    {
+      const std::uint32_t K       = static_cast<std::uint32_t>(removed_vertex.size());
+      const std::uint32_t n_nodes = K + 1;
+      const auto          range   = [&](const std::vector<std::uint32_t> &begin,
+                             const std::vector<std::uint32_t> &list,
+                             const std::uint32_t               k)
+      {
+        const std::uint32_t first = begin[k];
+        const std::uint32_t last =
+          k + 1 < K ? begin[k + 1] : static_cast<std::uint32_t>(list.size());
+        return std::make_pair(list.begin() + first, list.begin() + last);
+      };
+      // Node of collapse k: K - k, so that parents (later collapses) come first.
+      std::vector<std::uint32_t> creator(tets.size(), 0), destroyer(tets.size(), none);
+      for (std::uint32_t k = 0; k < K; ++k)
+      {
+        for (auto [i, end] = range(removed_begin, removed_list, k); i != end; ++i)
+          creator[*i] = K - k;
+        for (auto [i, end] = range(created_begin, created_list, k); i != end; ++i)
+          destroyer[*i] = K - k;
+      }
+      // Tets of dead ends never happen: every tet is alive at the end or removed once.
+      MultiTriangulation mt;
+      mt.vertices = position;
+      mt.fine_begin.assign(n_nodes + 1, 0);
+      for (std::uint32_t t = 0; t < tets.size(); ++t)
+        ++mt.fine_begin[creator[t] + 1];
+      for (std::uint32_t j = 0; j < n_nodes; ++j)
+        mt.fine_begin[j + 1] += mt.fine_begin[j];
+      std::vector<std::uint32_t> new_id(tets.size());
+      {
+        std::vector<std::uint32_t> next(mt.fine_begin.begin(), mt.fine_begin.end() - 1);
+        for (std::uint32_t t = 0; t < tets.size(); ++t)
+          new_id[t] = next[creator[t]]++;
+      }
+      mt.tets.resize(tets.size());
+      mt.creator.resize(tets.size());
+      mt.destroyer.resize(tets.size());
+      for (std::uint32_t t = 0; t < tets.size(); ++t)
+      {
+        mt.tets[new_id[t]]      = tets[t];
+        mt.creator[new_id[t]]   = creator[t];
+        mt.destroyer[new_id[t]] = destroyer[t];
+      }
+      mt.coarse_begin.assign(n_nodes + 1, 0);
+      mt.node_vertex.assign(n_nodes, none);
+      mt.vertex_node.assign(position.size(), 0);
+      for (std::uint32_t j = 1; j < n_nodes; ++j)
+      {
+        const std::uint32_t k = K - j;
+        for (auto [i, end] = range(created_begin, created_list, k); i != end; ++i)
+          mt.coarse_list.push_back(new_id[*i]);
+        mt.coarse_begin[j + 1] = static_cast<std::uint32_t>(mt.coarse_list.size());
+        mt.node_vertex[j]      = removed_vertex[k];
+        mt.vertex_node[removed_vertex[k]] = j;
+      }
+
+      // Errors and balls, children (earlier collapses, larger node ids) first.
+      mt.error.assign(n_nodes, 0);
+      mt.ball.assign(n_nodes, {{0, 0, 0, 0}});
+      const auto volume = [&](const std::uint32_t t)
+      {
+        const Tet &c = mt.tets[t];
+        return mesh::signed_volume(position[c[0]],
+                                   position[c[1]],
+                                   position[c[2]],
+                                   position[c[3]]);
+      };
+      for (std::uint32_t j = n_nodes; j-- > 0;)
+      {
+        std::vector<std::uint32_t> points;
+        double                     sum = 0;
+        for (std::uint32_t i = mt.coarse_begin[j]; i < mt.coarse_begin[j + 1]; ++i)
+        {
+          sum += volume(mt.coarse_list[i]);
+          points.insert(points.end(),
+                        mt.tets[mt.coarse_list[i]].begin(),
+                        mt.tets[mt.coarse_list[i]].end());
+        }
+        for (std::uint32_t t = mt.fine_begin[j]; t < mt.fine_begin[j + 1]; ++t)
+          points.insert(points.end(), mt.tets[t].begin(), mt.tets[t].end());
+        sort_unique(points);
+        Point3 center = {{0, 0, 0}};
+        for (const std::uint32_t p : points)
+          for (unsigned int d = 0; d < 3; ++d)
+            center[d] += position[p][d] / points.size();
+        double radius = 0;
+        for (const std::uint32_t p : points)
+          radius = std::max(radius, distance(center, position[p]));
+        double error = mt.n_coarse(j) > 0 ? sum / mt.n_coarse(j) : 0;
+        for (std::uint32_t t = mt.fine_begin[j]; t < mt.fine_begin[j + 1]; ++t)
+          if (const std::uint32_t c = mt.destroyer[t]; c != none)
+          {
+            error         = std::max(error, mt.error[c]);
+            const auto &b = mt.ball[c];
+            radius = std::max(radius, distance(center, {{b[0], b[1], b[2]}}) + b[3]);
+          }
+        // Round the radius up so that containment survives rounding.
+        mt.error[j] = error;
+        mt.ball[j]  = {{center[0], center[1], center[2], radius * (1 + 1e-12)}};
+      }
+      return mt;
+    }
+  } // namespace
+
+
+  double
+  tet_quality(const Point3 &a, const Point3 &b, const Point3 &c, const Point3 &d)
+  {
+    const double volume = mesh::signed_volume(a, b, c, d);
+    if (!(volume > 0))
+      return volume < 0 ? -1 : 0;
+    double squares = 0;
+    for (const auto &[p, q] : {std::pair(&a, &b),
+                               std::pair(&a, &c),
+                               std::pair(&a, &d),
+                               std::pair(&b, &c),
+                               std::pair(&b, &d),
+                               std::pair(&c, &d)})
+    {
+      const Point3 e = minus(*p, *q);
+      squares += dot(e, e);
+    }
+    return 12 * std::cbrt(9 * volume * volume) / squares;
+  }
+
+
+  MultiTriangulation
+  build_multi_triangulation(const mesh::TetMesh             &mesh,
+                            const BuilderParameters         &parameters,
+                            const std::vector<unsigned int> &locked)
+  {
+    Decimator decimator(mesh, parameters, locked);
+    decimator.run();
+    return decimator.assemble();
+  }
+} // namespace lacerta::mt

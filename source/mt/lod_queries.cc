@@ -1,0 +1,115 @@
+// The level of detail queries: `uniform` and `focus`.
+
+#include <lacerta/mt/lod_query.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace lacerta::mt
+{
+  namespace
+  {
+    /**
+     * The same cell size everywhere.
+     */
+    class UniformQuery : public LodQuery
+    {
+    public:
+      static void
+      declare_parameters(dealii::ParameterHandler &prm)
+      {
+        prm.declare_entry("Cell size",
+                          "0",
+                          dealii::Patterns::Double(0.0, 1e3),
+                          "Largest cell size allowed everywhere [m]; 0 extracts the full "
+                          "resolution.");
+      }
+
+      void
+      parse_parameters(dealii::ParameterHandler &prm) override
+      {
+        error = error_of_cell_size(prm.get_double("Cell size"));
+      }
+
+      double
+      minimum_error(const mesh::Point3 &, double) const override
+      {
+        return error;
+      }
+
+    private:
+      double error = 0;
+    };
+
+
+    /**
+     * The surgical focus of Section 4.2: fine within a radius of the tool, coarser
+     * with the distance from it.
+     */
+    class FocusQuery : public LodQuery
+    {
+    public:
+      static void
+      declare_parameters(dealii::ParameterHandler &prm)
+      {
+        prm.declare_entry("Radius",
+                          "0.02",
+                          dealii::Patterns::Double(0.0, 1e3),
+                          "Radius of the ball around the focus where the cell size is "
+                          "'Cell size near the focus' [m].");
+        prm.declare_entry("Cell size near the focus",
+                          "0",
+                          dealii::Patterns::Double(0.0, 1e3),
+                          "Largest cell size within the radius [m]; 0 is the full "
+                          "resolution.");
+        prm.declare_entry(
+          "Cell size growth",
+          "0.5",
+          dealii::Patterns::Double(0.0, 1e3),
+          "How fast the allowed cell size grows beyond the radius: "
+          "h(d) = h0 + growth (d - radius) at distance d from the focus.");
+      }
+
+      void
+      parse_parameters(dealii::ParameterHandler &prm) override
+      {
+        radius    = prm.get_double("Radius");
+        near_size = prm.get_double("Cell size near the focus");
+        growth    = prm.get_double("Cell size growth");
+      }
+
+      void
+      set_focus(const mesh::Point3 &point) override
+      {
+        focus = point;
+      }
+
+      double
+      minimum_error(const mesh::Point3 &center, const double ball_radius) const override
+      {
+        // The allowed error grows with the distance, so its minimum over the ball is at
+        // the ball's point nearest to the focus.
+        const double d = std::max(0.0,
+                                  std::hypot(center[0] - focus[0],
+                                             center[1] - focus[1],
+                                             center[2] - focus[2])
+                                    - ball_radius);
+        return error_of_cell_size(near_size + growth * std::max(0.0, d - radius));
+      }
+
+    private:
+      double       radius = 0, near_size = 0, growth = 0;
+      mesh::Point3 focus = {{0, 0, 0}};
+    };
+  } // namespace
+
+  LACERTA_REGISTER_LOD_QUERY(
+    UniformQuery,
+    "uniform",
+    "The same largest cell size everywhere (subsection Uniform).");
+  LACERTA_REGISTER_LOD_QUERY(
+    FocusQuery,
+    "focus",
+    "Full resolution (or 'Cell size near the focus') within 'Radius' of the tool, "
+    "cells growing linearly with the distance beyond it (subsection Focus).");
+} // namespace lacerta::mt

@@ -1,0 +1,80 @@
+#include <lacerta/base/exceptions.h>
+#include <lacerta/mt/multi_triangulation.h>
+
+namespace lacerta::mt
+{
+  std::size_t
+  MultiTriangulation::memory_bytes() const
+  {
+    return vertices.capacity() * sizeof(mesh::Point3)
+           + tets.capacity() * sizeof(mesh::Tet)
+           + (creator.capacity() + destroyer.capacity() + fine_begin.capacity()
+              + coarse_begin.capacity() + coarse_list.capacity() + node_vertex.capacity()
+              + vertex_node.capacity())
+               * sizeof(std::uint32_t)
+           + error.capacity() * sizeof(double)
+           + ball.capacity() * sizeof(std::array<double, 4>);
+  }
+
+
+  std::array<double, 4>
+  MultiTriangulation::barycentric(const unsigned int t, const mesh::Point3 &p) const
+  {
+    const auto &[a, b, c, d] = tets[t];
+    const double volume =
+      mesh::signed_volume(vertices[a], vertices[b], vertices[c], vertices[d]);
+    return {{mesh::signed_volume(p, vertices[b], vertices[c], vertices[d]) / volume,
+             mesh::signed_volume(vertices[a], p, vertices[c], vertices[d]) / volume,
+             mesh::signed_volume(vertices[a], vertices[b], p, vertices[d]) / volume,
+             mesh::signed_volume(vertices[a], vertices[b], vertices[c], p) / volume}};
+  }
+
+
+  void
+  MultiTriangulation::check(const std::string &source) const
+  {
+    const std::size_t n = n_nodes();
+    if (n == 0 || fine_begin.size() != n + 1 || coarse_begin.size() != n + 1
+        || error.size() != n || ball.size() != n || creator.size() != tets.size()
+        || destroyer.size() != tets.size() || vertex_node.size() != vertices.size()
+        || fine_begin.front() != 0 || fine_begin.back() != tets.size()
+        || coarse_begin.front() != 0 || coarse_begin.back() != coarse_list.size())
+      throw_error("Multi-Triangulation '", source, "': inconsistent array sizes.");
+    for (std::size_t j = 0; j < n; ++j)
+    {
+      if (fine_begin[j] > fine_begin[j + 1] || coarse_begin[j] > coarse_begin[j + 1])
+        throw_error("Multi-Triangulation '", source, "': node ", j, " has bad ranges.");
+      for (std::uint32_t t = fine_begin[j]; t < fine_begin[j + 1]; ++t)
+        if (creator[t] != j)
+          throw_error("Multi-Triangulation '", source, "': tet ", t, " misplaced.");
+      for (std::uint32_t k = coarse_begin[j]; k < coarse_begin[j + 1]; ++k)
+        if (coarse_list[k] >= tets.size() || destroyer[coarse_list[k]] != j
+            || creator[coarse_list[k]] >= j)
+          throw_error("Multi-Triangulation '",
+                      source,
+                      "': node ",
+                      j,
+                      " removes a tet it does not own or that a later node inserts.");
+      if (j > 0
+          && (node_vertex[j] >= vertices.size()
+              || coarse_begin[j] == coarse_begin[j + 1]))
+        throw_error(
+          "Multi-Triangulation '",
+          source,
+          "': node ",
+          j,
+          " has no vertex or no coarse tetrahedra (it could never be applied).");
+    }
+    for (std::size_t t = 0; t < tets.size(); ++t)
+    {
+      for (const unsigned int v : tets[t])
+        if (v >= vertices.size())
+          throw_error("Multi-Triangulation '", source, "': tet ", t, " bad vertex.");
+      if (destroyer[t] != mesh::invalid_index && destroyer[t] >= n)
+        throw_error("Multi-Triangulation '", source, "': tet ", t, " bad destroyer.");
+      const auto &[a, b, c, d] = tets[t];
+      if (!(mesh::signed_volume(vertices[a], vertices[b], vertices[c], vertices[d]) > 0))
+        throw_error("Multi-Triangulation '", source, "': tet ", t, " is inverted.");
+    }
+  }
+} // namespace lacerta::mt

@@ -1,0 +1,231 @@
+#include <lacerta/base/exceptions.h>
+#include <lacerta/base/parameter_utilities.h>
+#include <lacerta/base/parsed_function.h>
+#include <lacerta/mt/multiresolution.h>
+
+#include <deal.II/base/function_parser.h>
+
+#include <algorithm>
+#include <cmath>
+#include <ostream>
+
+namespace lacerta::mt
+{
+  void
+  Multiresolution::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection("Multiresolution");
+    prm.declare_entry(
+      "Enabled",
+      "false",
+      dealii::Patterns::Bool(),
+      "Simulate on a level of detail extracted from a Multi-Triangulation "
+      "(Section 4) that follows the focus; without it no MT is built.");
+    prm.declare_entry("Cache directory",
+                      "mt-cache",
+                      dealii::Patterns::Anything(),
+                      "Where built MTs are kept, one file per mesh and builder "
+                      "parameters (mt-<key>.lmt); a stale or corrupted file is rebuilt. "
+                      "Empty: always build, never write.");
+    prm.declare_entry("Focus path",
+                      "0; 0; 0",
+                      dealii::Patterns::Anything(),
+                      "Position of the tool the level of detail follows, as a function "
+                      "of t: three expressions separated by ';' [m].");
+    prm.declare_entry("Re-extraction distance",
+                      "0.005",
+                      dealii::Patterns::Double(0.0, 1e3),
+                      "The level of detail is extracted again when the focus has moved "
+                      "more than this since the last extraction [m].");
+    prm.declare_entry("Re-extraction interval",
+                      "50",
+                      dealii::Patterns::Integer(1, 100000000),
+                      "... or when this many steps have passed since the last one.");
+    LodQueryRegistry::declare_selector(prm,
+                                       "Query",
+                                       "focus",
+                                       "How fine the level of detail must be where.");
+    LodQueryRegistry::declare_all_in_subsections(prm);
+    prm.enter_subsection("Builder");
+    prm.declare_entry(
+      "Minimum quality",
+      "0.1",
+      dealii::Patterns::Double(0.001, 0.9),
+      "No decimation step may create a tetrahedron of lower mean-ratio "
+      "quality 12 (3V)^(2/3) / sum of squared edges (1 regular, 0 flat).");
+    prm.declare_entry(
+      "Maximum boundary error",
+      "0.01",
+      dealii::Patterns::Double(0.0, 1.0),
+      "Largest approximate Hausdorff distance from the decimated boundary "
+      "to the input boundary, as a fraction of the bounding box diagonal.");
+    prm.declare_entry(
+      "Boundary error weight",
+      "10",
+      dealii::Patterns::Double(0.0, 1e6),
+      "How much the Hausdorff distance d delays the removal of a boundary "
+      "vertex: priority = mean incident volume (1 + weight d / mean "
+      "edge length).");
+    prm.leave_subsection();
+    prm.leave_subsection();
+  }
+
+
+  bool
+  Multiresolution::enabled(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection("Multiresolution");
+    const bool on = prm.get_bool("Enabled");
+    prm.leave_subsection();
+    return on;
+  }
+
+
+  Multiresolution::Multiresolution(dealii::ParameterHandler        &prm,
+                                   const mesh::TetMesh             &input,
+                                   const std::vector<unsigned int> &locked)
+  {
+    prm.enter_subsection("Multiresolution");
+    const std::string directory = prm.get("Cache directory");
+    path = parse_function("Multiresolution/Focus path", prm.get("Focus path"), 3, true);
+    distance = prm.get_double("Re-extraction distance");
+    interval = prm.get_integer("Re-extraction interval");
+    query    = LodQueryRegistry::create_and_parse(prm.get("Query"), prm);
+    BuilderParameters parameters;
+    prm.enter_subsection("Builder");
+    parameters.minimum_quality        = prm.get_double("Minimum quality");
+    parameters.maximum_boundary_error = prm.get_double("Maximum boundary error");
+    parameters.boundary_error_weight  = prm.get_double("Boundary error weight");
+    prm.leave_subsection();
+    prm.leave_subsection();
+
+    mt         = load_or_build(input, parameters, locked, directory, cache);
+    lod        = std::make_unique<Lod>(mt);
+    last_focus = focus(0);
+    query->set_focus(last_focus);
+    lod->extract(*query);
+    make_active_mesh();
+  }
+
+
+  Multiresolution::~Multiresolution() = default;
+
+
+  mesh::Point3
+  Multiresolution::focus(const double time) const
+  {
+    const dealii::Point<3> origin;
+    path->set_time(time);
+    return {{path->value(origin, 0), path->value(origin, 1), path->value(origin, 2)}};
+  }
+
+
+  bool
+  Multiresolution::update(const double time, const unsigned int step)
+  {
+    const mesh::Point3 now = focus(time);
+    const double       moved =
+      std::hypot(now[0] - last_focus[0], now[1] - last_focus[1], now[2] - last_focus[2]);
+    if (moved <= distance && step - last_step < interval)
+      return false;
+    last_focus = now;
+    last_step  = step;
+    query->set_focus(now);
+    if (!lod->extract(*query))
+      return false;
+    make_active_mesh();
+    return true;
+  }
+
+
+  void
+  Multiresolution::make_active_mesh()
+  {
+    vertices = lod->active_vertices();
+    mesh     = lod->make_mesh(vertices, "level of detail");
+  }
+
+
+  void
+  Multiresolution::transfer_state(const std::vector<std::uint32_t> &old_vertices,
+                                  const std::vector<double>        &old_x,
+                                  const std::vector<double>        &old_v,
+                                  std::vector<double>              &x,
+                                  std::vector<double>              &v)
+  {
+    const auto old_index = [&old_vertices](const std::uint32_t g)
+    {
+      const auto found = std::lower_bound(old_vertices.begin(), old_vertices.end(), g);
+      return (found != old_vertices.end() && *found == g)
+               ? static_cast<std::size_t>(found - old_vertices.begin())
+               : static_cast<std::size_t>(-1);
+    };
+    n_kept = n_new = 0;
+    for (std::size_t i = 0; i < vertices.size(); ++i)
+    {
+      const std::size_t o = old_index(vertices[i]);
+      if (o != static_cast<std::size_t>(-1))
+      {
+        ++n_kept;
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          x[3 * i + d] = old_x[3 * o + d];
+          v[3 * i + d] = old_v[3 * o + d];
+        }
+        continue;
+      }
+      ++n_new;
+      auto [tet, lambda] = lod->locate_in_previous(vertices[i]);
+      double sum         = 0;
+      for (double &l : lambda)
+        sum += (l = std::max(l, 0.0));
+      for (unsigned int d = 0; d < 3; ++d)
+        x[3 * i + d] = v[3 * i + d] = 0;
+      for (unsigned int k = 0; k < 4; ++k)
+      {
+        const std::size_t corner = old_index(mt.tets[tet][k]);
+        if (corner == static_cast<std::size_t>(-1))
+          throw_error("Multiresolution: internal error, the tetrahedron found for a new "
+                      "vertex is not in the previous level of detail.");
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          x[3 * i + d] += lambda[k] / sum * old_x[3 * corner + d];
+          v[3 * i + d] += lambda[k] / sum * old_v[3 * corner + d];
+        }
+      }
+    }
+  }
+
+
+  void
+  Multiresolution::print_summary(std::ostream &out, const bool test_mode) const
+  {
+    const auto n_input =
+      std::count(mt.destroyer.begin(), mt.destroyer.end(), mesh::invalid_index);
+    out << "Multiresolution: mesh of " << n_input << " tetrahedra, " << mt.n_vertices()
+        << " particles; MT of " << mt.n_nodes() << " nodes, " << mt.n_tets()
+        << " tetrahedra (root " << mt.n_fine(0) << "), " << mt.memory_bytes() / 1024
+        << " KiB, " << (cache.loaded ? "loaded from the cache" : "built");
+    if (!test_mode)
+      out << " in " << cache.seconds << " s"
+          << (cache.file.empty() || cache.loaded
+                ? ""
+                : " (cache " + cache.reason + "; written to " + cache.file + ")");
+    out << "\nLevel of detail: " << mesh.n_tets() << " tetrahedra, " << mesh.n_vertices()
+        << " particles, focus at (" << last_focus[0] << ", " << last_focus[1] << ", "
+        << last_focus[2] << ")\n";
+  }
+
+
+  void
+  Multiresolution::print_change(std::ostream &out,
+                                const double  time,
+                                const double  total_mass) const
+  {
+    const auto change = lod->last_change();
+    out << "Level of detail at t = " << time << " s: " << mesh.n_tets() << " tetrahedra, "
+        << mesh.n_vertices() << " particles (" << change[0] << " nodes applied, "
+        << change[1] << " undone; " << n_new << " particles interpolated), mass "
+        << total_mass << " kg\n";
+  }
+} // namespace lacerta::mt

@@ -1,0 +1,386 @@
+// The Multi-Triangulation: builder, extraction, state transfer and storage invariants.
+
+#include <lacerta/mt/builder.h>
+#include <lacerta/mt/lod.h>
+#include <lacerta/mt/lod_query.h>
+#include <lacerta/mt/storage.h>
+
+#include <deal.II/base/function.h>
+
+#include <gtest/gtest.h>
+
+#include "physics_test_support.h"
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+namespace lacerta
+{
+  namespace
+  {
+    using mesh::Point3;
+    using mesh::Tet;
+
+    /// A query from a name and parameters, as a scene would make it.
+    std::unique_ptr<mt::LodQuery>
+    make_query(const std::string &name, const std::map<std::string, std::string> &values)
+    {
+      dealii::ParameterHandler prm;
+      mt::LodQueryRegistry::declare_all_in_subsections(prm);
+      prm.enter_subsection(mt::LodQueryRegistry::subsection_name(name));
+      for (const auto &[entry, value] : values)
+        prm.set(entry, value);
+      prm.leave_subsection();
+      return mt::LodQueryRegistry::create_and_parse(name, prm);
+    }
+
+    std::set<Tet>
+    sorted_tets(const std::vector<Tet> &tets)
+    {
+      std::set<Tet> result;
+      for (Tet t : tets)
+      {
+        std::sort(t.begin(), t.end());
+        result.insert(t);
+      }
+      return result;
+    }
+
+    std::set<Tet>
+    active_set(const mt::MultiTriangulation &mt, const mt::Lod &lod)
+    {
+      std::vector<Tet> tets;
+      for (const auto t : lod.active_tets())
+        tets.push_back(mt.tets[t]);
+      return sorted_tets(tets);
+    }
+
+    /// A unit box of 6^3 hexahedra split into tetrahedra (planar boundary).
+    const mesh::TetMesh &
+    box()
+    {
+      static const mesh::TetMesh mesh =
+        test_support::distorted_box(6, 0.0, dealii::Point<3>(1, 1, 1));
+      return mesh;
+    }
+
+    /// The box bent into a rounded shape: a curved boundary to approximate.
+    mesh::TetMesh
+    rounded_box()
+    {
+      std::vector<Point3> points = box().get_vertices();
+      for (Point3 &p : points)
+      {
+        const Point3 c = {{p[0] - 0.5, p[1] - 0.5, p[2] - 0.5}};
+        const double r = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+        for (unsigned int d = 0; d < 3; ++d)
+          p[d] = c[d] * (1 - 0.3 * r);
+      }
+      return mesh::TetMesh(points, box().get_tets(), "rounded box");
+    }
+
+    /// The corners of a boundary face of @p m.
+    std::array<Point3, 3>
+    corners(const mesh::TetMesh &m, const mesh::BoundaryFace &face)
+    {
+      const Tet  &t = m.tet(face.tet);
+      const auto &l = mesh::TetMesh::face_vertices[face.face];
+      return {{m.vertex(t[l[0]]), m.vertex(t[l[1]]), m.vertex(t[l[2]])}};
+    }
+
+    const mt::MultiTriangulation &
+    box_mt()
+    {
+      static const mt::MultiTriangulation mt =
+        mt::build_multi_triangulation(box(), mt::BuilderParameters());
+      return mt;
+    }
+
+    /// Boundary faces of an extracted mesh lie on the box's faces, which means no face
+    /// inside the box is left unmatched: the mesh is conforming.
+    void
+    expect_conforming_box(const mesh::TetMesh &lod)
+    {
+      for (const auto &face : lod.get_boundary_faces())
+      {
+        const Tet &t      = lod.tet(face.tet);
+        bool       planar = false;
+        for (unsigned int d = 0; d < 3; ++d)
+          for (const double side : {0.0, 1.0})
+          {
+            bool all = true;
+            for (const unsigned int k : mesh::TetMesh::face_vertices[face.face])
+              all = all && std::abs(lod.vertex(t[k])[d] - side) < 1e-12;
+            planar = planar || all;
+          }
+        EXPECT_TRUE(planar)
+          << "a boundary face inside the box: the mesh is not conforming";
+      }
+    }
+  } // namespace
+
+
+  TEST(MultiTriangulation, BuildIsConsistentAndDecimates)
+  {
+    const auto &mt = box_mt();
+    EXPECT_NO_THROW(mt.check("box"));
+    EXPECT_EQ(mt.n_vertices(), box().n_vertices());
+    EXPECT_LT(mt.n_fine(0), box().n_tets() / 10);
+    // Every vertex but those of the root comes back through exactly one node.
+    std::set<unsigned int> inserted;
+    for (unsigned int j = 1; j < mt.n_nodes(); ++j)
+      EXPECT_TRUE(inserted.insert(mt.node_vertex[j]).second);
+    // No collapse created a tetrahedron below the quality bound (none inverted).
+    for (unsigned int t = 0; t < mt.n_tets(); ++t)
+      if (mt.destroyer[t] != mesh::invalid_index)
+      {
+        const Tet &c = mt.tets[t];
+        EXPECT_GE(mt::tet_quality(mt.vertices[c[0]],
+                                  mt.vertices[c[1]],
+                                  mt.vertices[c[2]],
+                                  mt.vertices[c[3]]),
+                  mt::BuilderParameters().minimum_quality);
+      }
+    // Errors never decrease towards the root.
+    for (unsigned int t = 0; t < mt.n_tets(); ++t)
+    {
+      if (mt.destroyer[t] != mesh::invalid_index && mt.creator[t] != 0)
+      {
+        EXPECT_GE(mt.error[mt.creator[t]], mt.error[mt.destroyer[t]]);
+      }
+    }
+  }
+
+
+  TEST(MultiTriangulation, FinestIsTheInputAndCoarsestIsTheRoot)
+  {
+    const auto &mt = box_mt();
+    mt::Lod     lod(mt);
+    lod.extract(*make_query("uniform", {{"Cell size", "0"}}));
+    EXPECT_EQ(active_set(mt, lod), sorted_tets(box().get_tets()));
+    lod.extract(*make_query("uniform", {{"Cell size", "1000"}}));
+    std::vector<Tet> root(mt.tets.begin() + mt.fine_begin[0],
+                          mt.tets.begin() + mt.fine_begin[1]);
+    EXPECT_EQ(active_set(mt, lod), sorted_tets(root));
+  }
+
+
+  TEST(MultiTriangulation, ExtractionsConformCoverTheVolumeAndKeepTheMass)
+  {
+    const auto                                  &mt = box_mt();
+    const dealii::Functions::ConstantFunction<3> density(1000);
+    for (const std::string size : {"0", "0.2", "0.4", "1000"})
+    {
+      mt::Lod lod(mt);
+      auto query = make_query("focus", {{"Radius", "0.2"}, {"Cell size growth", size}});
+      query->set_focus({{0.2, 0.3, 0.5}});
+      lod.extract(*query);
+      const mesh::TetMesh active = lod.make_mesh(lod.active_vertices(), "lod");
+      // Every active tetrahedron satisfies the query: the node that would refine it
+      // does not need applying.
+      for (const auto t : lod.active_tets())
+      {
+        if (const auto d = mt.destroyer[t]; d != mesh::invalid_index)
+        {
+          const auto &b = mt.ball[d];
+          EXPECT_LE(mt.error[d], query->minimum_error({{b[0], b[1], b[2]}}, b[3]));
+        }
+      }
+      expect_conforming_box(active);
+      EXPECT_NEAR(active.total_volume(), 1.0, 1e-12);
+      const auto masses = physics::compute_masses(active, density);
+      EXPECT_NEAR(std::accumulate(masses.begin(), masses.end(), 0.0), 1000.0, 1e-9);
+    }
+  }
+
+
+  TEST(MultiTriangulation, CurvedBoundaryStaysWithinTheHausdorffBound)
+  {
+    const mesh::TetMesh   input = rounded_box();
+    mt::BuilderParameters parameters;
+    parameters.maximum_boundary_error = 0.02;
+    const auto mt                     = mt::build_multi_triangulation(input, parameters);
+    EXPECT_NO_THROW(mt.check("rounded box"));
+    {
+      // Boundary decimation must not make the finest level unreachable.
+      mt::Lod finest(mt);
+      finest.extract(*make_query("uniform", {{"Cell size", "0"}}));
+      EXPECT_EQ(active_set(mt, finest), sorted_tets(input.get_tets()));
+    }
+    mt::Lod    lod(mt);
+    const auto root = lod.make_mesh(lod.active_vertices(), "root");
+    // Hausdorff distance from the input boundary vertices to the root's boundary.
+    const auto &points   = lod.active_vertices();
+    double      diagonal = 0, hausdorff = 0;
+    {
+      Point3 low = input.vertex(0), high = low;
+      for (const Point3 &p : input.get_vertices())
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          low[d]  = std::min(low[d], p[d]);
+          high[d] = std::max(high[d], p[d]);
+        }
+      diagonal = std::hypot(high[0] - low[0], high[1] - low[1], high[2] - low[2]);
+    }
+    for (unsigned int v = 0; v < input.n_vertices(); ++v)
+    {
+      if (!input.is_boundary_vertex(v))
+        continue;
+      double nearest = 1e300;
+      for (const auto &face : root.get_boundary_faces())
+      {
+        // The distance to a dense sample of the triangle overestimates the distance to
+        // the triangle by at most the sample spacing.
+        const auto [a, b, c] = corners(root, face);
+        for (int i = 0; i <= 20; ++i)
+          for (int j = 0; i + j <= 20; ++j)
+          {
+            const double  s = i / 20.0, r = j / 20.0;
+            const Point3  q = {{a[0] + s * (b[0] - a[0]) + r * (c[0] - a[0]),
+                                a[1] + s * (b[1] - a[1]) + r * (c[1] - a[1]),
+                                a[2] + s * (b[2] - a[2]) + r * (c[2] - a[2])}};
+            const Point3 &p = input.vertex(v);
+            nearest =
+              std::min(nearest, std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]));
+          }
+      }
+      hausdorff = std::max(hausdorff, nearest);
+    }
+    EXPECT_GT(hausdorff, 0.0);
+    // Sampling adds at most the sample spacing to the exact distance.
+    EXPECT_LE(hausdorff,
+              parameters.maximum_boundary_error * diagonal
+                + root.edge_length_range()[1] / 20);
+    EXPECT_LT(points.size(), input.n_vertices());
+    // The volume between the two boundaries is at most their area times the distance.
+    double area = 0;
+    for (const auto &face : input.get_boundary_faces())
+    {
+      const auto [a, b, c] = corners(input, face);
+      const Point3 u       = {{b[0] - a[0], b[1] - a[1], b[2] - a[2]}};
+      const Point3 w       = {{c[0] - a[0], c[1] - a[1], c[2] - a[2]}};
+      area += 0.5
+              * std::hypot(u[1] * w[2] - u[2] * w[1],
+                           u[2] * w[0] - u[0] * w[2],
+                           u[0] * w[1] - u[1] * w[0]);
+    }
+    EXPECT_LE(std::abs(root.total_volume() - input.total_volume()), area * hausdorff);
+    std::cout << "rounded box: root " << root.n_tets()
+              << " tetrahedra, Hausdorff distance " << hausdorff << " ("
+              << hausdorff / diagonal << " of the diagonal), volume "
+              << root.total_volume() / input.total_volume() << " of the input\n";
+  }
+
+
+  TEST(MultiTriangulation, IncrementalExtractionEqualsExtractionFromScratch)
+  {
+    const auto &mt = box_mt();
+    auto query = make_query("focus", {{"Radius", "0.15"}, {"Cell size growth", "0.3"}});
+    mt::Lod incremental(mt);
+    bool    some_change = false;
+    for (int step = 0; step <= 20; ++step)
+    {
+      query->set_focus({{0.05 * step, 0.5 + 0.3 * std::sin(step), 0.5}});
+      some_change |= incremental.extract(*query);
+      mt::Lod scratch(mt);
+      scratch.extract(*query);
+      ASSERT_EQ(active_set(mt, incremental), active_set(mt, scratch)) << "step " << step;
+      for (unsigned int j = 0; j < mt.n_nodes(); ++j)
+        ASSERT_EQ(incremental.is_applied(j), scratch.is_applied(j));
+    }
+    EXPECT_TRUE(some_change);
+  }
+
+
+  TEST(MultiTriangulation, NewParticlesLieInTetrahedraOfThePreviousLevel)
+  {
+    const auto &mt = box_mt();
+    auto    query = make_query("focus", {{"Radius", "0.1"}, {"Cell size growth", "0.5"}});
+    mt::Lod lod(mt);
+    unsigned int located = 0;
+    for (int step = 0; step <= 10; ++step)
+    {
+      const std::vector<std::uint32_t> before(lod.active_tets().begin(),
+                                              lod.active_tets().end());
+      const std::set<std::uint32_t>    previous(before.begin(), before.end());
+      const auto                       old_vertices = lod.active_vertices();
+      query->set_focus({{0.1 * step, 0.5, 0.5}});
+      lod.extract(*query);
+      for (const auto v : lod.active_vertices())
+      {
+        if (std::binary_search(old_vertices.begin(), old_vertices.end(), v))
+          continue;
+        const auto [tet, lambda] = lod.locate_in_previous(v);
+        EXPECT_TRUE(previous.count(tet)) << "vertex " << v;
+        for (const double l : lambda)
+          EXPECT_GE(l, -1e-10) << "vertex " << v << " outside its tetrahedron";
+        EXPECT_NEAR(lambda[0] + lambda[1] + lambda[2] + lambda[3], 1.0, 1e-12);
+        ++located;
+      }
+    }
+    EXPECT_GT(located, 10u);
+  }
+
+
+  TEST(MultiTriangulation, CacheLoadsIdenticallyAndRebuildsBadFiles)
+  {
+    const std::string directory = "mt_cache_test";
+    std::filesystem::remove_all(directory);
+    mt::CacheReport report;
+    const auto      built = mt::load_or_build(box(), {}, {}, directory, report);
+    EXPECT_FALSE(report.loaded);
+    EXPECT_EQ(report.reason, "missing");
+    const auto loaded = mt::load_or_build(box(), {}, {}, directory, report);
+    EXPECT_TRUE(report.loaded);
+    EXPECT_EQ(loaded.tets, built.tets);
+    EXPECT_EQ(loaded.coarse_list, built.coarse_list);
+    EXPECT_EQ(loaded.error, built.error);
+    EXPECT_EQ(loaded.ball, built.ball);
+    EXPECT_EQ(loaded.vertex_node, built.vertex_node);
+    const std::string file = report.file;
+
+    // One flipped byte in the middle: detected, rebuilt and rewritten.
+    {
+      std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+      f.seekg(static_cast<std::streamoff>(std::filesystem::file_size(file) / 2));
+      char c = 0;
+      f.read(&c, 1);
+      f.seekp(static_cast<std::streamoff>(std::filesystem::file_size(file) / 2));
+      c = static_cast<char>(~c);
+      f.write(&c, 1);
+    }
+    const auto repaired = mt::load_or_build(box(), {}, {}, directory, report);
+    EXPECT_FALSE(report.loaded);
+    EXPECT_NE(report.reason.find("corrupted"), std::string::npos) << report.reason;
+    EXPECT_EQ(repaired.tets, built.tets);
+    mt::load_or_build(box(), {}, {}, directory, report);
+    EXPECT_TRUE(report.loaded);
+
+    // Truncated: detected.
+    std::filesystem::resize_file(file, std::filesystem::file_size(file) - 10);
+    std::string reason;
+    EXPECT_FALSE(mt::load(file, mt::cache_key(box(), {}, {}), reason));
+    EXPECT_NE(reason.find("corrupted"), std::string::npos) << reason;
+
+    // Stale: a file made for other builder parameters under this name.
+    mt::BuilderParameters other;
+    other.minimum_quality = 0.2;
+    mt::save(built, mt::cache_key(box(), other, {}), file);
+    mt::load_or_build(box(), {}, {}, directory, report);
+    EXPECT_FALSE(report.loaded);
+    EXPECT_NE(report.reason.find("stale"), std::string::npos) << report.reason;
+    std::filesystem::remove_all(directory);
+  }
+
+
+  TEST(MultiTriangulation, LockedVerticesStayInEveryLevel)
+  {
+    const std::vector<unsigned int> locked = {0, 5, 17, 100};
+    const auto                      mt = mt::build_multi_triangulation(box(), {}, locked);
+    for (const unsigned int v : locked)
+      EXPECT_EQ(mt.vertex_node[v], 0u);
+  }
+} // namespace lacerta
