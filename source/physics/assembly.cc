@@ -3,6 +3,7 @@
 #include <deal.II/base/function.h>
 #include <deal.II/base/quadrature_lib.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace lacerta::physics
@@ -54,22 +55,36 @@ namespace lacerta::physics
   } // namespace
 
 
+  std::array<double, 4>
+  tet_mass_contributions(const mesh::TetMesh               &mesh,
+                         const unsigned int                 t,
+                         const dealii::Function<3, double> &density)
+  {
+    static const BarycentricRule rule;
+    std::array<double, 4>        m = {{0, 0, 0, 0}};
+    for_each_quadrature_point(mesh,
+                              t,
+                              rule,
+                              [&](unsigned int q, const dealii::Point<3> &x, double jxw)
+                              {
+                                const double sigma = density.value(x);
+                                for (unsigned int i = 0; i < 4; ++i)
+                                  m[i] += sigma * rule.coordinates[q][i] * jxw;
+                              });
+    return m;
+  }
+
+
   std::vector<double>
   compute_masses(const mesh::TetMesh &mesh, const dealii::Function<3, double> &density)
   {
-    const BarycentricRule rule;
-    std::vector<double>   masses(mesh.n_vertices(), 0.0);
+    std::vector<double> masses(mesh.n_vertices(), 0.0);
     for (unsigned int t = 0; t < mesh.n_tets(); ++t)
-      for_each_quadrature_point(mesh,
-                                t,
-                                rule,
-                                [&](unsigned int q, const dealii::Point<3> &x, double jxw)
-                                {
-                                  const double sigma = density.value(x);
-                                  for (unsigned int i = 0; i < 4; ++i)
-                                    masses[mesh.tet(t)[i]] +=
-                                      sigma * rule.coordinates[q][i] * jxw;
-                                });
+    {
+      const std::array<double, 4> m = tet_mass_contributions(mesh, t, density);
+      for (unsigned int i = 0; i < 4; ++i)
+        masses[mesh.tet(t)[i]] += m[i];
+    }
     return masses;
   }
 
@@ -89,6 +104,39 @@ namespace lacerta::physics
   }
 
 
+  double
+  tet_stiffness_factor(const mesh::TetMesh               &mesh,
+                       const unsigned int                 t,
+                       const dealii::Function<3, double> &youngs_modulus)
+  {
+    dealii::Point<3> centroid;
+    for (const unsigned int v : mesh.tet(t))
+      for (unsigned int d = 0; d < 3; ++d)
+        centroid[d] += 0.25 * mesh.vertex(v)[d];
+    return youngs_modulus.value(centroid) * mesh.volume(t);
+  }
+
+
+  std::array<double, 2>
+  edge_spring(const mesh::TetMesh               &mesh,
+              const unsigned int                 e,
+              const dealii::Function<3, double> &youngs_modulus)
+  {
+    const auto         &edge   = mesh.get_edges()[e];
+    const mesh::Point3 &a      = mesh.vertex(edge[0]);
+    const mesh::Point3 &b      = mesh.vertex(edge[1]);
+    const double        length = std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+    double              sum    = 0;
+    for (const unsigned int t : mesh.tets_of_vertex(edge[0]))
+    {
+      const mesh::Tet &tet = mesh.tet(t);
+      if (std::find(tet.begin(), tet.end(), edge[1]) != tet.end())
+        sum += tet_stiffness_factor(mesh, t, youngs_modulus);
+    }
+    return {{sum / (length * length), length}};
+  }
+
+
   SpringSet
   compute_springs(const mesh::TetMesh               &mesh,
                   const dealii::Function<3, double> &youngs_modulus)
@@ -105,11 +153,7 @@ namespace lacerta::physics
     std::vector<double> stiffness(edges.size(), 0.0);
     for (unsigned int t = 0; t < mesh.n_tets(); ++t)
     {
-      dealii::Point<3> centroid;
-      for (const unsigned int v : mesh.tet(t))
-        for (unsigned int d = 0; d < 3; ++d)
-          centroid[d] += 0.25 * mesh.vertex(v)[d];
-      const double e_times_v = youngs_modulus.value(centroid) * mesh.volume(t);
+      const double e_times_v = tet_stiffness_factor(mesh, t, youngs_modulus);
       for (const unsigned int e : mesh.tet_edges(t))
         stiffness[e] += e_times_v / (length[e] * length[e]);
     }
