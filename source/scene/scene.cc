@@ -1,4 +1,6 @@
 #include <lacerta/base/exceptions.h>
+#include <lacerta/cut/cutter.h>
+#include <lacerta/cut/tool.h>
 #include <lacerta/mesh/mesh_source.h>
 #include <lacerta/physics/assembly.h>
 #include <lacerta/physics/force_model.h>
@@ -20,6 +22,8 @@ namespace lacerta::scene
     physics::ForceModel::declare_parameters(prm);
     BodyForce::declare_parameters(prm);
     Constraint::declare_parameters(prm, constraint_names);
+    cut::Tool::declare_parameters(prm);
+    cut::Cutter::declare_parameters(prm);
   }
 
 
@@ -86,6 +90,16 @@ namespace lacerta::scene
     update_loads(0.0);
 
     system->set_force_model(physics::ForceModel::create(prm), n_threads);
+    initial_volume = mesh.total_volume();
+    tool           = cut::Tool::create(prm);
+    if (tool)
+      cutter = std::make_unique<cut::Cutter>(mesh,
+                                             *system,
+                                             material.density(),
+                                             material.youngs_modulus(),
+                                             integral_of_density,
+                                             cut::Cutter::parse_parameters(prm),
+                                             tool->blade(0.0));
   }
 
 
