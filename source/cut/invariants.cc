@@ -115,8 +115,8 @@ namespace lacerta::cut
   }
 
 
-  unsigned int
-  count_components(const mesh::TetMesh &mesh)
+  std::vector<double>
+  component_volumes(const mesh::TetMesh &mesh)
   {
     std::vector<unsigned int> parent(mesh.n_tets());
     std::iota(parent.begin(), parent.end(), 0u);
@@ -130,9 +130,20 @@ namespace lacerta::cut
       for (unsigned int f = 0; f < 4; ++f)
         if (mesh.neighbor(t, f) != mesh::invalid_index)
           parent[find(t)] = find(mesh.neighbor(t, f));
-    unsigned int n = 0;
+    std::map<unsigned int, double> volumes;
     for (unsigned int t = 0; t < mesh.n_tets(); ++t)
-      n += find(t) == t;
-    return n;
+      volumes[find(t)] += mesh.volume(t);
+    std::vector<double> result;
+    for (const auto &[root, v] : volumes)
+      result.push_back(v);
+    std::sort(result.begin(), result.end());
+    return result;
+  }
+
+
+  unsigned int
+  count_components(const mesh::TetMesh &mesh)
+  {
+    return static_cast<unsigned int>(component_volumes(mesh).size());
   }
 } // namespace lacerta::cut

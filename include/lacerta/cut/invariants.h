@@ -8,6 +8,7 @@
 #include <lacerta/mesh/tet_mesh.h>
 
 #include <string>
+#include <vector>
 
 namespace lacerta::physics
 {
@@ -30,6 +31,10 @@ namespace lacerta::cut
                    const physics::ParticleSystem &system,
                    double                         volume,
                    double                         integral_of_density);
+
+  /// Volumes of the connected components of @p mesh (through shared faces), sorted.
+  std::vector<double>
+  component_volumes(const mesh::TetMesh &mesh);
 
   /// Number of connected components of @p mesh through shared faces.
   unsigned int
