@@ -179,6 +179,9 @@ namespace lacerta::mesh
   void
   TetMesh::build_connectivity(const std::vector<FaceTag> &tags)
   {
+    const bool had_local_updates = !vertex_tets.empty();
+    vertex_tets.clear();
+    boundary_slot.clear();
     const unsigned int n_tets = tets.size();
 
     // Faces: sort (key, owner) so that the two sides of an interior face are adjacent.
@@ -282,8 +285,9 @@ namespace lacerta::mesh
         edges.push_back(key);
       tet_edge_ids[owner / 6][owner % 6] = edges.size() - 1;
     }
+    if (had_local_updates)
+      enable_local_updates();
   }
-
 
   double
   TetMesh::volume(const unsigned int t) const
@@ -420,5 +424,278 @@ namespace lacerta::mesh
 
     build_connectivity(tags);
     return new_index;
+  }
+
+
+  void
+  TetMesh::enable_local_updates()
+  {
+    if (!vertex_tets.empty())
+      return;
+    vertex_tets.assign(vertices.size(), {});
+    for (unsigned int t = 0; t < tets.size(); ++t)
+      for (const unsigned int v : tets[t])
+        vertex_tets[v].push_back(t);
+    boundary_slot.assign(4 * tets.size(), invalid_index);
+    for (unsigned int i = 0; i < boundary_faces.size(); ++i)
+      boundary_slot[4 * boundary_faces[i].tet + boundary_faces[i].face] = i;
+  }
+
+
+  unsigned int
+  TetMesh::find_edge_excluding(const unsigned int a,
+                               const unsigned int b,
+                               const unsigned int skip) const
+  {
+    for (const unsigned int t : vertex_tets[a])
+      if (t != skip)
+        for (unsigned int e = 0; e < 6; ++e)
+        {
+          const unsigned int p = tets[t][edge_vertices[e][0]];
+          const unsigned int q = tets[t][edge_vertices[e][1]];
+          if ((p == a && q == b) || (p == b && q == a))
+            return tet_edge_ids[t][e];
+        }
+    return invalid_index;
+  }
+
+
+  unsigned int
+  TetMesh::find_edge(const unsigned int a, const unsigned int b) const
+  {
+    return find_edge_excluding(a, b, invalid_index);
+  }
+
+
+  void
+  TetMesh::tets_around_edge(const unsigned int         a,
+                            const unsigned int         b,
+                            std::vector<unsigned int> &out) const
+  {
+    for (const unsigned int t : vertex_tets[a])
+      if (std::find(tets[t].begin(), tets[t].end(), b) != tets[t].end())
+        out.push_back(t);
+  }
+
+
+  unsigned int
+  TetMesh::add_vertex(const Point3 &x)
+  {
+    vertices.push_back(x);
+    vertex_tets.emplace_back();
+    boundary_vertex.push_back(0);
+    return static_cast<unsigned int>(vertices.size() - 1);
+  }
+
+
+  void
+  TetMesh::remove_boundary_face(const unsigned int t, const unsigned int f)
+  {
+    const unsigned int slot = boundary_slot[4 * t + f];
+    if (slot == invalid_index)
+      return;
+    const BoundaryFace last                 = boundary_faces.back();
+    boundary_faces[slot]                    = last;
+    boundary_slot[4 * last.tet + last.face] = slot;
+    boundary_faces.pop_back();
+    boundary_slot[4 * t + f] = invalid_index;
+  }
+
+
+  void
+  TetMesh::add_boundary_face(const unsigned int t,
+                             const unsigned int f,
+                             const unsigned int id)
+  {
+    boundary_slot[4 * t + f] = static_cast<unsigned int>(boundary_faces.size());
+    boundary_faces.push_back({t, f, id});
+  }
+
+
+  void
+  TetMesh::replace_tets(const std::vector<unsigned int>                &removed,
+                        const std::vector<Tet>                         &added,
+                        const std::vector<std::array<unsigned int, 4>> &face_ids,
+                        std::vector<unsigned int>                      &added_ids,
+                        EdgeUpdate                                     &update)
+  {
+    if (added.size() < removed.size() || face_ids.size() != added.size())
+      throw_error("TetMesh::replace_tets: ",
+                  removed.size(),
+                  " tetrahedra cannot be replaced by ",
+                  added.size(),
+                  ".");
+    update = EdgeUpdate();
+    // Edge ids of the new tets, looked up while the old tets are still in place, so
+    // that an edge that survives keeps its id (and its spring).
+    std::vector<std::array<unsigned int, 6>> new_edge_ids(added.size());
+    std::vector<std::pair<std::array<unsigned int, 2>, unsigned int>> created;
+    for (std::size_t k = 0; k < added.size(); ++k)
+      for (unsigned int e = 0; e < 6; ++e)
+      {
+        unsigned int a = added[k][edge_vertices[e][0]], b = added[k][edge_vertices[e][1]];
+        if (a > b)
+          std::swap(a, b);
+        unsigned int id = find_edge(a, b);
+        if (id == invalid_index)
+        {
+          const auto found = std::find_if(created.begin(),
+                                          created.end(),
+                                          [&](const auto &c)
+                                          { return c.first[0] == a && c.first[1] == b; });
+          if (found != created.end())
+            id = found->second;
+          else
+          {
+            id = static_cast<unsigned int>(edges.size());
+            edges.push_back({{a, b}});
+            created.push_back({{{a, b}}, id});
+            ++update.n_added;
+          }
+        }
+        new_edge_ids[k][e] = id;
+      }
+
+    // Take the old tets out: stars, boundary faces, neighbours' back links.
+    std::vector<std::array<unsigned int, 3>> old_edges; // a, b, id
+    for (const unsigned int r : removed)
+    {
+      for (unsigned int e = 0; e < 6; ++e)
+      {
+        unsigned int a = tets[r][edge_vertices[e][0]], b = tets[r][edge_vertices[e][1]];
+        old_edges.push_back({{std::min(a, b), std::max(a, b), tet_edge_ids[r][e]}});
+      }
+      for (const unsigned int v : tets[r])
+      {
+        auto &star = vertex_tets[v];
+        star.erase(std::find(star.begin(), star.end(), r));
+      }
+      for (unsigned int f = 0; f < 4; ++f)
+      {
+        remove_boundary_face(r, f);
+        const unsigned int n = neighbors[4 * r + f];
+        if (n != invalid_index)
+          for (unsigned int g = 0; g < 4; ++g)
+            if (neighbors[4 * n + g] == r)
+              neighbors[4 * n + g] = invalid_index;
+        neighbors[4 * r + f] = invalid_index;
+      }
+    }
+    std::sort(old_edges.begin(), old_edges.end());
+    old_edges.erase(std::unique(old_edges.begin(), old_edges.end()), old_edges.end());
+
+    // Put the new tets in.
+    added_ids.resize(added.size());
+    for (std::size_t k = 0; k < added.size(); ++k)
+    {
+      unsigned int slot;
+      if (k < removed.size())
+        slot = removed[k];
+      else
+      {
+        slot = static_cast<unsigned int>(tets.size());
+        tets.emplace_back();
+        tet_edge_ids.emplace_back();
+        neighbors.insert(neighbors.end(), 4, invalid_index);
+        boundary_slot.insert(boundary_slot.end(), 4, invalid_index);
+      }
+      added_ids[k]       = slot;
+      tets[slot]         = added[k];
+      tet_edge_ids[slot] = new_edge_ids[k];
+      for (const unsigned int v : added[k])
+        vertex_tets[v].push_back(slot);
+    }
+    // Neighbours: the tet sharing a face is in the star of the face's vertices.
+    std::vector<std::pair<unsigned int, unsigned int>> open_faces;
+    for (std::size_t k = 0; k < added.size(); ++k)
+    {
+      const unsigned int t = added_ids[k];
+      for (unsigned int f = 0; f < 4; ++f)
+      {
+        if (neighbors[4 * t + f] != invalid_index)
+          continue;
+        const unsigned int a = tets[t][face_vertices[f][0]],
+                           b = tets[t][face_vertices[f][1]],
+                           c = tets[t][face_vertices[f][2]];
+        unsigned int other = invalid_index, other_face = 0;
+        for (const unsigned int s : vertex_tets[a])
+        {
+          if (s == t)
+            continue;
+          const Tet &q   = tets[s];
+          const auto has = [&](unsigned int v)
+          { return std::find(q.begin(), q.end(), v) != q.end(); };
+          if (has(b) && has(c))
+          {
+            other = s;
+            for (unsigned int g = 0; g < 4; ++g)
+              if (q[g] != a && q[g] != b && q[g] != c)
+                other_face = g;
+            break;
+          }
+        }
+        if (other == invalid_index)
+          add_boundary_face(t, f, face_ids[k][f]);
+        else
+        {
+          neighbors[4 * t + f]              = other;
+          neighbors[4 * other + other_face] = t;
+          remove_boundary_face(other, other_face);
+        }
+      }
+    }
+
+    // Retire the edges no tetrahedron uses any more, largest id first, so that the
+    // last slot moved into a hole is always a live edge.
+    std::vector<unsigned int> dead;
+    for (const auto &e : old_edges)
+      if (find_edge(e[0], e[1]) == invalid_index)
+        dead.push_back(e[2]);
+    std::sort(dead.rbegin(), dead.rend());
+    for (const unsigned int r : dead)
+    {
+      const unsigned int last = static_cast<unsigned int>(edges.size() - 1);
+      if (r != last)
+      {
+        edges[r] = edges[last];
+        for (const unsigned int t : vertex_tets[edges[r][0]])
+          for (unsigned int e = 0; e < 6; ++e)
+            if (tet_edge_ids[t][e] == last)
+              tet_edge_ids[t][e] = r;
+      }
+      update.moves.push_back({{r, last}});
+      edges.pop_back();
+    }
+
+    // Boundary flags of every vertex involved, and the touched edges by final id.
+    const auto refresh_vertex = [&](const unsigned int v)
+    {
+      if (v >= boundary_vertex.size())
+        boundary_vertex.resize(v + 1, 0);
+      std::uint8_t on_boundary = 0;
+      for (const unsigned int t : vertex_tets[v])
+        for (unsigned int f = 0; f < 4; ++f)
+          if (neighbors[4 * t + f] == invalid_index && tets[t][f] != v)
+            on_boundary = 1;
+      boundary_vertex[v] = on_boundary;
+    };
+    for (const auto &e : old_edges)
+    {
+      refresh_vertex(e[0]);
+      refresh_vertex(e[1]);
+      const unsigned int id = find_edge(e[0], e[1]);
+      if (id != invalid_index)
+        update.touched.push_back(id);
+    }
+    for (std::size_t k = 0; k < added.size(); ++k)
+    {
+      for (const unsigned int v : added[k])
+        refresh_vertex(v);
+      for (const unsigned int id : tet_edge_ids[added_ids[k]])
+        update.touched.push_back(id);
+    }
+    std::sort(update.touched.begin(), update.touched.end());
+    update.touched.erase(std::unique(update.touched.begin(), update.touched.end()),
+                         update.touched.end());
   }
 } // namespace lacerta::mesh

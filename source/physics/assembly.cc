@@ -59,22 +59,36 @@ namespace lacerta::physics
   } // namespace
 
 
+  std::array<double, 4>
+  tet_mass_contributions(const mesh::TetMesh               &mesh,
+                         const unsigned int                 t,
+                         const dealii::Function<3, double> &density)
+  {
+    static const BarycentricRule rule;
+    std::array<double, 4>        m = {{0, 0, 0, 0}};
+    for_each_quadrature_point(mesh,
+                              t,
+                              rule,
+                              [&](unsigned int q, const dealii::Point<3> &x, double jxw)
+                              {
+                                const double sigma = density.value(x);
+                                for (unsigned int i = 0; i < 4; ++i)
+                                  m[i] += sigma * rule.coordinates[q][i] * jxw;
+                              });
+    return m;
+  }
+
+
   std::vector<double>
   compute_masses(const mesh::TetMesh &mesh, const dealii::Function<3, double> &density)
   {
-    const BarycentricRule rule;
-    std::vector<double>   masses(mesh.n_vertices(), 0.0);
+    std::vector<double> masses(mesh.n_vertices(), 0.0);
     for (unsigned int t = 0; t < mesh.n_tets(); ++t)
-      for_each_quadrature_point(mesh,
-                                t,
-                                rule,
-                                [&](unsigned int q, const dealii::Point<3> &x, double jxw)
-                                {
-                                  const double sigma = density.value(x);
-                                  for (unsigned int i = 0; i < 4; ++i)
-                                    masses[mesh.tet(t)[i]] +=
-                                      sigma * rule.coordinates[q][i] * jxw;
-                                });
+    {
+      const std::array<double, 4> m = tet_mass_contributions(mesh, t, density);
+      for (unsigned int i = 0; i < 4; ++i)
+        masses[mesh.tet(t)[i]] += m[i];
+    }
     return masses;
   }
 
@@ -178,6 +192,35 @@ namespace lacerta::physics
   } // namespace
 
 
+  double
+  tet_stiffness_factor(const mesh::TetMesh               &mesh,
+                       const unsigned int                 t,
+                       const dealii::Function<3, double> &youngs_modulus)
+  {
+    return youngs_modulus.value(centroid_of(mesh, t)) * mesh.volume(t);
+  }
+
+
+  std::array<double, 2>
+  edge_spring(const mesh::TetMesh               &mesh,
+              const unsigned int                 e,
+              const dealii::Function<3, double> &youngs_modulus)
+  {
+    const auto         &edge   = mesh.get_edges()[e];
+    const mesh::Point3 &a      = mesh.vertex(edge[0]);
+    const mesh::Point3 &b      = mesh.vertex(edge[1]);
+    const double        length = std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+    double              sum    = 0;
+    for (const unsigned int t : mesh.tets_of_vertex(edge[0]))
+    {
+      const mesh::Tet &tet = mesh.tet(t);
+      if (std::find(tet.begin(), tet.end(), edge[1]) != tet.end())
+        sum += tet_stiffness_factor(mesh, t, youngs_modulus);
+    }
+    return {{sum / (length * length), length}};
+  }
+
+
   SpringSet
   compute_springs(const mesh::TetMesh               &mesh,
                   const dealii::Function<3, double> &youngs_modulus)
@@ -186,8 +229,7 @@ namespace lacerta::physics
       mesh,
       [&](const unsigned int t, const std::vector<double> &length)
       {
-        const double e_times_v =
-          youngs_modulus.value(centroid_of(mesh, t)) * mesh.volume(t);
+        const double          e_times_v = tet_stiffness_factor(mesh, t, youngs_modulus);
         std::array<double, 6> k{};
         for (unsigned int i = 0; i < 6; ++i)
           k[i] =

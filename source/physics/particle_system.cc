@@ -23,7 +23,8 @@ namespace lacerta::physics
   ParticleSystem::set_force_model(std::unique_ptr<ForceModel> model,
                                   const unsigned int          n_threads)
   {
-    forces = std::move(model);
+    forces        = std::move(model);
+    force_threads = n_threads;
     forces->initialize(*this, n_threads);
   }
 
@@ -46,7 +47,33 @@ namespace lacerta::physics
   void
   ParticleSystem::update_force_model(const unsigned int n_threads)
   {
-    forces->initialize(*this, n_threads);
+    force_threads = n_threads;
+    refresh_force_model();
+  }
+
+
+  void
+  ParticleSystem::refresh_force_model()
+  {
+    forces->initialize(*this, force_threads);
+  }
+
+
+  unsigned int
+  ParticleSystem::add_particle(const std::array<double, 3> &rest_x,
+                               const std::array<double, 3> &x,
+                               const std::array<double, 3> &v)
+  {
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      position.push_back(x[d]);
+      velocity.push_back(v[d]);
+      external_force.push_back(0.0);
+      rest.push_back(rest_x[d]);
+    }
+    mass.push_back(0.0);
+    free.push_back(1.0);
+    return n_particles() - 1;
   }
 
 

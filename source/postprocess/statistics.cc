@@ -1,6 +1,7 @@
 // Postprocessor `statistics`: one row per step in statistics.csv.
 
 #include <lacerta/base/exceptions.h>
+#include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/postprocess/postprocessor.h>
 
 #include <cstdio>
@@ -35,8 +36,10 @@ namespace lacerta::postprocess
         if (!file)
           throw_error("Cannot write '", file_name, "'.");
         test_mode = test;
-        file << "step,time,time_step,substeps,kinetic_energy,elastic_energy,"
-                "body_force_energy,input_work,force_wall_s,step_wall_s\n";
+        file
+          << "step,time,time_step,substeps,kinetic_energy,elastic_energy,"
+             "body_force_energy,input_work,force_wall_s,step_wall_s,mesh_size,cut_tets,"
+             "created_tets,update_wall_ms\n";
       }
 
       bool
@@ -51,7 +54,7 @@ namespace lacerta::postprocess
         char line[512];
         std::snprintf(line,
                       sizeof(line),
-                      "%u,%.9g,%.6g,%u,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g\n",
+                      "%u,%.9g,%.6g,%u,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%u,%u,%u,%.6g\n",
                       s.step,
                       s.time,
                       s.time_step,
@@ -61,7 +64,11 @@ namespace lacerta::postprocess
                       s.body_force_energy,
                       s.input_work,
                       test_mode ? 0.0 : s.force_seconds,
-                      test_mode ? 0.0 : s.step_seconds);
+                      test_mode ? 0.0 : s.step_seconds,
+                      s.mesh->n_tets(),
+                      s.cut_tets,
+                      s.created_tets,
+                      test_mode ? 0.0 : 1e3 * s.update_seconds);
         file << line;
       }
 
@@ -77,5 +84,7 @@ namespace lacerta::postprocess
     "statistics",
     "statistics.csv with one row per step: time, time step, "
     "sub-steps, kinetic, elastic and body-force energy, work of "
-    "the loads, wall time of force evaluation and of the step.");
+    "the loads, wall time of force evaluation and of the step, and the "
+    "paper's Table 1 columns: mesh size, tetrahedra cut and created, mesh "
+    "update wall time (ms).");
 } // namespace lacerta::postprocess

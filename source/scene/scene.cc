@@ -1,4 +1,6 @@
 #include <lacerta/base/exceptions.h>
+#include <lacerta/cut/cutter.h>
+#include <lacerta/cut/tool.h>
 #include <lacerta/mesh/mesh_source.h>
 #include <lacerta/mt/multiresolution.h>
 #include <lacerta/physics/assembly.h>
@@ -23,6 +25,8 @@ namespace lacerta::scene
     BodyForce::declare_parameters(prm);
     Constraint::declare_parameters(prm, constraint_names);
     mt::Multiresolution::declare_parameters(prm);
+    cut::Tool::declare_parameters(prm);
+    cut::Cutter::declare_parameters(prm);
   }
 
 
@@ -54,6 +58,21 @@ namespace lacerta::scene
     system = std::make_unique<physics::ParticleSystem>(std::vector<double>());
     assemble(active_mesh(), 0.0);
     system->set_force_model(physics::ForceModel::create(prm), n_threads);
+    initial_volume = mesh.total_volume();
+    tool           = cut::Tool::create(prm);
+    if (tool)
+    {
+      if (multiresolution)
+        throw_error("Tool/Type: cuts on the multiresolution model are not available yet; "
+                    "set 'Multiresolution/Enabled = false' or 'Tool/Type = none'.");
+      cutter = std::make_unique<cut::Cutter>(mesh,
+                                             *system,
+                                             material.density(),
+                                             material.youngs_modulus(),
+                                             integral_of_density,
+                                             cut::Cutter::parse_parameters(prm),
+                                             tool->blade(0.0));
+    }
   }
 
 

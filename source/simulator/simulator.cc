@@ -1,5 +1,8 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/input_path.h>
+#include <lacerta/cut/cutter.h>
+#include <lacerta/cut/invariants.h>
+#include <lacerta/cut/tool.h>
 #include <lacerta/fem/study.h>
 #include <lacerta/mt/multiresolution.h>
 #include <lacerta/physics/integrator.h>
@@ -137,6 +140,15 @@ namespace lacerta
       "Print no timings and no progress line and write zero wall times, so "
       "that the output of two runs can be compared.");
 
+    prm.declare_entry(
+      "Check invariants",
+      "false",
+      dealii::Patterns::Bool(),
+      "Check the mesh and mass invariants (volume, conformity, no inverted or flat "
+      "element, springs = edges, total mass = integral of the density) at the start "
+      "and after every step that cuts; a violation stops the run. Costs O(mesh size) "
+      "per cutting step.");
+
     prm.enter_subsection("Stability");
     prm.declare_entry(
       "Time step above limit",
@@ -231,6 +243,7 @@ namespace lacerta
     time_step        = prm.get_double("Time step");
     n_threads        = prm.get_integer("Number of threads");
     test_mode        = prm.get_bool("Test mode");
+    check_invariants = prm.get_bool("Check invariants");
     prm.enter_subsection("Stability");
     substep_when_unstable = prm.get("Time step above limit") == "substep";
     safety_factor         = prm.get_double("Safety factor");
@@ -315,7 +328,23 @@ namespace lacerta
     unsigned int substeps = choose_substeps();
 
     physics::BlowUpMonitor monitor(system, energy_tolerance);
-    postprocess::RunState  state;
+    const auto             check = [&](const unsigned int step)
+    {
+      if (!check_invariants)
+        return;
+      const std::string problem = cut::check_invariants(scene->mesh,
+                                                        system,
+                                                        scene->initial_volume,
+                                                        scene->integral_of_density);
+      if (!problem.empty())
+        throw_error("Check invariants: after step ", step, ": ", problem, ".");
+    };
+    check(0);
+    // The paper's Table 1, averaged over the steps that cut.
+    unsigned int          cutting_steps      = 0;
+    unsigned long long    n_integrator_steps = 0;
+    double                sum_cut = 0, sum_created = 0, sum_update = 0, sum_relax = 0;
+    postprocess::RunState state;
     state.mesh     = &scene->active_mesh();
     state.system   = &system;
     state.material = &scene->material;
@@ -363,16 +392,47 @@ namespace lacerta
     for (unsigned int step = 1; step <= n_steps; ++step)
     {
       const double dt         = std::min(time_step, end_time - time);
-      const double h          = dt / substeps;
       const auto   step_start = Clock::now();
+      state.cut_tets = state.created_tets = 0;
+      state.update_seconds                = 0;
+      if (scene->cutter)
+      {
+        dealii::TimerOutput::Scope   scope(timer, "cut");
+        const cut::CutStepStatistics cut =
+          scene->cutter->move_blade(scene->tool->blade(time + dt));
+        state.cut_tets       = cut.cut_tets;
+        state.created_tets   = cut.created_tets;
+        state.update_seconds = cut.update_seconds;
+        if (cut.changed)
+        {
+          // New particles and springs: the integrator's scratch space, the stability
+          // limit and the energy baseline of the blow-up monitor start afresh.
+          check(step);
+          integrator->initialize(system);
+          substeps       = choose_substeps();
+          state.substeps = substeps;
+          monitor        = physics::BlowUpMonitor(system, energy_tolerance);
+        }
+      }
+      const auto   relax_start = Clock::now();
+      const double h           = dt / substeps;
       {
         dealii::TimerOutput::Scope scope(timer, "integration");
         system.force_seconds = 0;
+        n_integrator_steps += substeps;
         for (unsigned int k = 0; k < substeps; ++k)
         {
           scene->update_loads(time + k * h);
           integrator->step(system, time + k * h, h);
         }
+      }
+      if (state.cut_tets > 0)
+      {
+        ++cutting_steps;
+        sum_cut += state.cut_tets;
+        sum_created += state.created_tets;
+        sum_update += state.update_seconds;
+        sum_relax += seconds_since(relax_start);
       }
       time = (step == n_steps) ? end_time : time + dt;
       if (scene->update_level_of_detail(time, step, std::cout))
@@ -418,14 +478,25 @@ namespace lacerta
     if (show_progress && last_progress > 0)
       std::fprintf(stderr, "\n");
 
-    std::cout << "Done: " << n_steps << " steps, " << n_steps * substeps
+    std::cout << "Done: " << n_steps << " steps, " << n_integrator_steps
               << " integrator steps\n";
+    if (scene->cutter)
+    {
+      std::cout << "Cut summary (Table 1 columns, averages over the " << cutting_steps
+                << " steps that cut): MS " << scene->mesh.n_tets() << ", CuT "
+                << (cutting_steps ? sum_cut / cutting_steps : 0.0) << ", CrT "
+                << (cutting_steps ? sum_created / cutting_steps : 0.0);
+      if (!test_mode && cutting_steps > 0)
+        std::cout << ", UpdT " << 1e3 * sum_update / cutting_steps << " ms, RxT "
+                  << 1e3 * sum_relax / cutting_steps << " ms";
+      std::cout << "; mesh components " << cut::count_components(scene->mesh) << "\n";
+    }
     if (!test_mode)
     {
       const double wall = seconds_since(run_start);
       std::cout << "Wall time " << wall << " s; force evaluation throughput "
                 << double(system.springs.size()) * integrator->n_evaluations_per_step()
-                     * n_steps * substeps / wall
+                     * n_integrator_steps / wall
                 << " springs/s (whole loop)\n";
       timer.print_summary();
     }

@@ -8,6 +8,7 @@
  */
 #pragma once
 
+#include <lacerta/cut/geometry.h>
 #include <lacerta/cut/split_table.h>
 
 #include <algorithm>
@@ -24,61 +25,8 @@
 
 namespace lacerta::cut::test_support
 {
-  inline Point
-  sub(const Point &a, const Point &b)
-  {
-    return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-  }
-
-  inline Point
-  add(const Point &a, const Point &b)
-  {
-    return {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
-  }
-
-  inline Point
-  scale(const double s, const Point &a)
-  {
-    return {s * a[0], s * a[1], s * a[2]};
-  }
-
-  inline Point
-  lerp(const Point &a, const Point &b, const double t)
-  {
-    return add(a, scale(t, sub(b, a)));
-  }
-
-  inline double
-  dot(const Point &a, const Point &b)
-  {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-  }
-
-  inline Point
-  cross(const Point &a, const Point &b)
-  {
-    return {a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0]};
-  }
-
-  inline double
-  norm(const Point &a)
-  {
-    return std::sqrt(dot(a, a));
-  }
-
-  inline Point
-  normalized(const Point &a)
-  {
-    return scale(1.0 / norm(a), a);
-  }
-
-  inline double
-  volume(const Point &a, const Point &b, const Point &c, const Point &d)
-  {
-    return signed_volume6(a, b, c, d) / 6.0;
-  }
+  // Vector algebra (sub, add, scale, lerp, dot, cross, norm, normalized, volume) comes
+  // from the library's lacerta/cut/geometry.h, which the cutter uses too.
 
   inline double
   triangle_area(const Point &a, const Point &b, const Point &c)

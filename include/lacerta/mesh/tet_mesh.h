@@ -188,7 +188,102 @@ namespace lacerta::mesh
     std::vector<unsigned int>
     sort_spatially();
 
+    /**
+     * What replace_tets() did to the unique edges, so that arrays indexed by edge id
+     * (the springs) can follow: first `n_added` edges were appended, then every pair
+     * (to, from) of `moves`, in order, copied edge `from` (the last one) into slot `to`
+     * and dropped the last slot. `touched` holds the final ids of every edge whose
+     * incident tetrahedra changed (new edges and surviving edges of removed tets).
+     */
+    struct EdgeUpdate
+    {
+      unsigned int                             n_added = 0;
+      std::vector<std::array<unsigned int, 2>> moves;
+      std::vector<unsigned int>                touched;
+    };
+
+    /**
+     * Builds the vertex-to-tetrahedra incidence and the boundary face slots that local
+     * updates need. Only the cutter calls it: a scene without cuts never pays for it.
+     * Idempotent.
+     */
+    void
+    enable_local_updates();
+
+    /// Whether enable_local_updates() was called.
+    bool
+    has_local_updates() const
+    {
+      return !vertex_tets.empty() || vertices.empty();
+    }
+
+    /// The tetrahedra incident to vertex @p v (needs enable_local_updates()).
+    const std::vector<unsigned int> &
+    tets_of_vertex(const unsigned int v) const
+    {
+      return vertex_tets[v];
+    }
+
+    /// The id of the edge joining @p a and @p b, or invalid_index (needs local updates).
+    unsigned int
+    find_edge(unsigned int a, unsigned int b) const;
+
+    /// Appends the tetrahedra containing both @p a and @p b to @p out (local updates).
+    void
+    tets_around_edge(unsigned int               a,
+                     unsigned int               b,
+                     std::vector<unsigned int> &out) const;
+
+    /**
+     * The boundary id of face @p f of tetrahedron @p t, or invalid_index if it is not
+     * a boundary face (needs local updates).
+     */
+    unsigned int
+    boundary_id(const unsigned int t, const unsigned int f) const
+    {
+      const unsigned int slot = boundary_slot[4 * t + f];
+      return slot == invalid_index ? invalid_index : boundary_faces[slot].boundary_id;
+    }
+
+    /// Appends a vertex at rest position @p x and returns its id (local updates).
+    unsigned int
+    add_vertex(const Point3 &x);
+
+    /**
+     * Replaces the tetrahedra @p removed by @p added (at least as many), updating
+     * neighbours, boundary faces, edges and boundary flags locally: the cost is
+     * proportional to the number of tetrahedra involved and the size of their vertex
+     * stars, not to the mesh size. The first added tetrahedra take the slots of the
+     * removed ones, the others are appended; their ids are returned in @p added_ids.
+     * A face of an added tetrahedron that finds no neighbour becomes a boundary face
+     * with id @p face_boundary_ids[k][f]. The caller guarantees that the result is
+     * conforming (the cutter does, by deciding every cut from global ids).
+     */
+    void
+    replace_tets(const std::vector<unsigned int>                &removed,
+                 const std::vector<Tet>                         &added,
+                 const std::vector<std::array<unsigned int, 4>> &face_boundary_ids,
+                 std::vector<unsigned int>                      &added_ids,
+                 EdgeUpdate                                     &edge_update);
+
   private:
+    /// Edge id of (a, b) in a tetrahedron of the star of a other than @p skip.
+    unsigned int
+    find_edge_excluding(unsigned int a, unsigned int b, unsigned int skip) const;
+
+    /// Removes boundary face (t, f) if it is one.
+    void
+    remove_boundary_face(unsigned int t, unsigned int f);
+
+    /// Adds boundary face (t, f) with @p id.
+    void
+    add_boundary_face(unsigned int t, unsigned int f, unsigned int id);
+
+    /// For local updates: the tetrahedra around every vertex.
+    std::vector<std::vector<unsigned int>> vertex_tets;
+    /// For local updates: index into boundary_faces of face 4 t + f, or invalid_index.
+    std::vector<unsigned int> boundary_slot;
+
     /// Rebuilds neighbours, boundary faces, edges and boundary flags from the tets.
     void
     build_connectivity(const std::vector<FaceTag> &tags);

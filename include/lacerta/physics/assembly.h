@@ -7,6 +7,7 @@
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/spring_set.h>
 
+#include <array>
 #include <vector>
 
 namespace dealii
@@ -39,6 +40,34 @@ namespace lacerta::physics
    * k_e = Σ_{τ ∋ e} E(τ) V(τ) / |e|², E evaluated at the centroid of τ, rest length
    * |e| in the rest configuration. Springs are in the order of mesh.get_edges().
    */
+  /**
+   * The mass contribution ∫_τ σ c_i of tetrahedron @p t of @p mesh to each of its four
+   * vertices (Section 3.1), with the rule of compute_masses(); they add up to ∫_τ σ.
+   * The cutter uses it to update the masses around a cut locally.
+   */
+  std::array<double, 4>
+  tet_mass_contributions(const mesh::TetMesh               &mesh,
+                         unsigned int                       t,
+                         const dealii::Function<3, double> &density);
+
+  /**
+   * The contribution E(centroid) V(τ) of tetrahedron @p t to the numerator of every
+   * one of its edges' stiffness k_e = Σ E V / |e|² (Section 3.2).
+   */
+  double
+  tet_stiffness_factor(const mesh::TetMesh               &mesh,
+                       unsigned int                       t,
+                       const dealii::Function<3, double> &youngs_modulus);
+
+  /**
+   * The stiffness of edge @p e = (a, b) from the tetrahedra around it, and its rest
+   * length, as compute_springs() gives them; local (needs mesh.enable_local_updates()).
+   */
+  std::array<double, 2>
+  edge_spring(const mesh::TetMesh               &mesh,
+              unsigned int                       e,
+              const dealii::Function<3, double> &youngs_modulus);
+
   SpringSet
   compute_springs(const mesh::TetMesh               &mesh,
                   const dealii::Function<3, double> &youngs_modulus);

@@ -82,6 +82,22 @@ namespace lacerta::physics
     void
     update_force_model(unsigned int n_threads);
 
+    /**
+     * Re-initialises the force model after the springs changed (a cut), on the thread
+     * count it was set with.
+     */
+    void
+    refresh_force_model();
+
+    /**
+     * Appends a free particle with rest position @p rest, position @p x, velocity
+     * @p v and zero mass (the cutter sets the masses); returns its index.
+     */
+    unsigned int
+    add_particle(const std::array<double, 3> &rest,
+                 const std::array<double, 3> &x,
+                 const std::array<double, 3> &v);
+
     /// The force model.
     const ForceModel &
     force_model() const
@@ -118,5 +134,6 @@ namespace lacerta::physics
   private:
     std::vector<double>         rest;
     std::unique_ptr<ForceModel> forces;
+    unsigned int                force_threads = 1;
   };
 } // namespace lacerta::physics

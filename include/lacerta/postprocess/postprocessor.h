@@ -44,6 +44,10 @@ namespace lacerta::postprocess
     double kinetic_energy = 0, elastic_energy = 0, body_force_energy = 0, input_work = 0;
     /// Wall time of this step's force evaluations and of the whole step (s).
     double force_seconds = 0, step_seconds = 0;
+    /// Cuts of this step (the paper's Table 1): tetrahedra cut and created, and the
+    /// wall time of the mesh update (s); all zero in a scene without a tool.
+    unsigned int cut_tets = 0, created_tets = 0;
+    double       update_seconds = 0;
   };
 
 

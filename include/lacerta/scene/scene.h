@@ -22,6 +22,12 @@ namespace lacerta::mt
   class Multiresolution;
 }
 
+namespace lacerta::cut
+{
+  class Tool;
+  class Cutter;
+} // namespace lacerta::cut
+
 namespace lacerta::scene
 {
   /**
@@ -79,10 +85,15 @@ namespace lacerta::scene
     std::vector<std::unique_ptr<Constraint>> constraints;
     /// The body forces.
     std::vector<std::unique_ptr<BodyForce>> body_forces;
-    /// ∫σ over the mesh, with the rule of the mass assembly.
+    /// ∫σ over the mesh, with the rule of the mass assembly (kept up to date by cuts).
     double integral_of_density = 0;
     /// The multiresolution model, only if the scene enables it.
     std::unique_ptr<mt::Multiresolution> multiresolution;
+    /// Volume of the mesh as built (cuts conserve it).
+    double initial_volume = 0;
+    /// The cutting tool and the cutter, only if `Tool/Type` is not `none`.
+    std::unique_ptr<cut::Tool>   tool;
+    std::unique_ptr<cut::Cutter> cutter;
 
   private:
     /**

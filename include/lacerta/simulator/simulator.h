@@ -83,6 +83,7 @@ namespace lacerta
     double                                                   time_step;
     unsigned int                                             n_threads;
     bool                                                     test_mode;
+    bool                                                     check_invariants;
     bool                                                     substep_when_unstable;
     double                                                   safety_factor;
     double                                                   energy_tolerance;

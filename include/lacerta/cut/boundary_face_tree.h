@@ -1,0 +1,87 @@
+/**
+ * @file
+ * A bounding-volume tree over the boundary faces of the deformed object: the first
+ * contact of the scalpel (paper, Section 6.1, which used OpenGL picking for it).
+ */
+#pragma once
+
+#include <lacerta/cut/geometry.h>
+#include <lacerta/mesh/tet_mesh.h>
+
+#include <vector>
+
+namespace lacerta::cut
+{
+  /**
+   * Axis-aligned boxes over the boundary faces, built once by median splits and
+   * refitted bottom-up as the tissue deforms (the topology of the tree does not change
+   * with the positions). Faces a cut creates are kept in a short list that is searched
+   * linearly and folded into a rebuild once it is a tenth of the tree, so that the
+   * cost of a cut stays proportional to the faces it creates. Faces that stopped being
+   * boundary are skipped at query time.
+   */
+  class BoundaryFaceTree
+  {
+  public:
+    /// A boundary face: its tetrahedron, local face and three vertex ids.
+    struct Face
+    {
+      unsigned int                tet;
+      unsigned int                face;
+      std::array<unsigned int, 3> vertices;
+    };
+
+    /// Builds the tree over the boundary faces of @p mesh at positions @p x (3 per
+    /// vertex).
+    void
+    build(const mesh::TetMesh &mesh, const double *x);
+
+    /**
+     * Recomputes every box for the positions @p x (O(number of faces), no allocation),
+     * or rebuilds the tree if the faces added since the last build are many.
+     */
+    void
+    refit(const mesh::TetMesh &mesh, const double *x);
+
+    /// Records boundary face (tet, face) of @p mesh, created by a cut.
+    void
+    add_face(const mesh::TetMesh &mesh, unsigned int tet, unsigned int face);
+
+    /**
+     * Appends to @p hits the boundary faces whose box overlaps @p box and that are still
+     * boundary faces of @p mesh.
+     */
+    void
+    query(const mesh::TetMesh &mesh, const Box &box, std::vector<Face> &hits) const;
+
+    /// Number of faces in the tree and the pending list.
+    std::size_t
+    size() const
+    {
+      return faces.size() + extra.size();
+    }
+
+    /// The triangle of @p f at positions @p x.
+    static std::array<Point, 3>
+    triangle(const Face &f, const double *x);
+
+  private:
+    struct Node
+    {
+      Box          box;
+      unsigned int first, count; // leaf: faces [first, first+count); inner: count = 0
+      unsigned int left, right;
+    };
+
+    unsigned int
+    build_node(unsigned int first, unsigned int count, const double *x);
+
+    static Box
+    face_box(const Face &f, const double *x);
+
+    std::vector<Face> faces;
+    std::vector<Face> extra;
+    std::vector<Node> nodes;
+    const double     *last_positions = nullptr;
+  };
+} // namespace lacerta::cut

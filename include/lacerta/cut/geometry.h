@@ -1,0 +1,180 @@
+/**
+ * @file
+ * Small vector algebra and intersection predicates on plain points, shared by the
+ * cutter, the bounding-volume tree and the tests. Plain C++17, inline: the cutter's
+ * inner loops call them per edge.
+ */
+#pragma once
+
+#include <lacerta/cut/tet_decomposition.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace lacerta::cut
+{
+  /// a - b.
+  inline Point
+  sub(const Point &a, const Point &b)
+  {
+    return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+  }
+
+  /// a + b.
+  inline Point
+  add(const Point &a, const Point &b)
+  {
+    return {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
+  }
+
+  /// s a.
+  inline Point
+  scale(const double s, const Point &a)
+  {
+    return {s * a[0], s * a[1], s * a[2]};
+  }
+
+  /// a + t (b - a).
+  inline Point
+  lerp(const Point &a, const Point &b, const double t)
+  {
+    return add(a, scale(t, sub(b, a)));
+  }
+
+  /// Scalar product.
+  inline double
+  dot(const Point &a, const Point &b)
+  {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  }
+
+  /// Vector product.
+  inline Point
+  cross(const Point &a, const Point &b)
+  {
+    return {a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0]};
+  }
+
+  /// Euclidean length.
+  inline double
+  norm(const Point &a)
+  {
+    return std::sqrt(dot(a, a));
+  }
+
+  /// a / |a|.
+  inline Point
+  normalized(const Point &a)
+  {
+    return scale(1.0 / norm(a), a);
+  }
+
+  /// Signed volume of the tetrahedron (a, b, c, d).
+  inline double
+  volume(const Point &a, const Point &b, const Point &c, const Point &d)
+  {
+    return signed_volume6(a, b, c, d) / 6.0;
+  }
+
+  /**
+   * Whether the segment [p, q] meets the triangle (a, b, c), boundaries included; on a
+   * hit @p t is the parameter along the segment. Möller-Trumbore; a segment lying in
+   * the triangle's plane counts as no hit (the cutter treats it through the plane
+   * sides instead).
+   */
+  inline bool
+  segment_hits_triangle(const Point &p,
+                        const Point &q,
+                        const Point &a,
+                        const Point &b,
+                        const Point &c,
+                        double      &t)
+  {
+    const Point  d   = sub(q, p);
+    const Point  e1  = sub(b, a);
+    const Point  e2  = sub(c, a);
+    const Point  h   = cross(d, e2);
+    const double det = dot(e1, h);
+    const double tol = 1e-14 * norm(d) * norm(e1) * norm(e2);
+    if (std::abs(det) <= tol)
+      return false;
+    const Point  s = sub(p, a);
+    const double u = dot(s, h) / det;
+    if (u < 0 || u > 1)
+      return false;
+    const Point  r = cross(s, e1);
+    const double v = dot(d, r) / det;
+    if (v < 0 || u + v > 1)
+      return false;
+    t = dot(e2, r) / det;
+    return t >= 0 && t <= 1;
+  }
+
+  /// Whether two triangles intersect (an edge of one crosses the other).
+  inline bool
+  triangles_intersect(const std::array<Point, 3> &x, const std::array<Point, 3> &y)
+  {
+    double t;
+    for (unsigned int i = 0; i < 3; ++i)
+      if (segment_hits_triangle(x[i], x[(i + 1) % 3], y[0], y[1], y[2], t)
+          || segment_hits_triangle(y[i], y[(i + 1) % 3], x[0], x[1], x[2], t))
+        return true;
+    return false;
+  }
+
+  /**
+   * Barycentric coordinates of @p x in the tetrahedron (a, b, c, d); they sum to one.
+   */
+  inline std::array<double, 4>
+  barycentric(const Point &a,
+              const Point &b,
+              const Point &c,
+              const Point &d,
+              const Point &x)
+  {
+    const double v  = signed_volume6(a, b, c, d);
+    const double l1 = signed_volume6(a, x, c, d) / v;
+    const double l2 = signed_volume6(a, b, x, d) / v;
+    const double l3 = signed_volume6(a, b, c, x) / v;
+    return {{1.0 - l1 - l2 - l3, l1, l2, l3}};
+  }
+
+  /// An axis-aligned box.
+  struct Box
+  {
+    Point lower{{1e300, 1e300, 1e300}};
+    Point upper{{-1e300, -1e300, -1e300}};
+
+    /// Grows the box to contain @p p.
+    void
+    extend(const Point &p)
+    {
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        lower[d] = std::min(lower[d], p[d]);
+        upper[d] = std::max(upper[d], p[d]);
+      }
+    }
+
+    /// Grows the box to contain @p b.
+    void
+    extend(const Box &b)
+    {
+      extend(b.lower);
+      extend(b.upper);
+    }
+
+    /// Whether the boxes overlap.
+    bool
+    overlaps(const Box &b) const
+    {
+      for (unsigned int d = 0; d < 3; ++d)
+        if (lower[d] > b.upper[d] || b.lower[d] > upper[d])
+          return false;
+      return true;
+    }
+  };
+} // namespace lacerta::cut
