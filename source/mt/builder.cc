@@ -324,16 +324,19 @@ namespace lacerta::mt
         std::sort(list.begin(), list.end());
       }
 
-      /// The cells around @p u in the mesh closed by the ghost vertex, in @p cells.
+      /**
+       * The cells around @p u in the mesh closed by the ghost vertex, in @p cells;
+       * @p faces are u's boundary faces.
+       */
       void
-      closed_star(const std::uint32_t                        u,
-                  std::vector<std::array<std::uint32_t, 4>> &cells) const
+      closed_star(const std::uint32_t                              u,
+                  const std::vector<std::array<std::uint32_t, 3>> &faces,
+                  std::vector<std::array<std::uint32_t, 4>>       &cells) const
       {
         cells.clear();
         for (const std::uint32_t t : star[u])
           cells.push_back(tets[t]);
-        boundary_faces(u, ghost_faces);
-        for (const auto &f : ghost_faces)
+        for (const auto &f : faces)
           cells.push_back({{ghost, f[0], f[1], f[2]}});
       }
 
@@ -347,13 +350,16 @@ namespace lacerta::mt
        * links (this test runs for every candidate that passes the quality test):
        * common vertices = the ring of vertices around edge vw; then every common edge
        * or triangle has its vertices in that ring, a handful, so those are compared in
-       * short lists.
+       * short lists. @p faces_of_v are v's boundary faces (the caller has them).
        */
       bool
-      link_condition(const std::uint32_t v, const std::uint32_t w) const
+      link_condition(const std::uint32_t                              v,
+                     const std::vector<std::array<std::uint32_t, 3>> &faces_of_v,
+                     const std::uint32_t                              w) const
       {
-        closed_star(v, cells_v);
-        closed_star(w, cells_w);
+        closed_star(v, faces_of_v, cells_v);
+        boundary_faces(w, ghost_faces);
+        closed_star(w, ghost_faces, cells_w);
         // Vertices: mark Lk(v), promote those also in Lk(w) (common), then those of
         // Lk(vw) (ring); the condition holds when every common vertex is in the ring
         // and every ring vertex is common.
@@ -438,9 +444,28 @@ namespace lacerta::mt
       }
 
       /**
+       * Prepares boundary_error() for vertex @p v, whose boundary faces are
+       * @p faces: their normals and samples do not depend on the candidate target.
+       */
+      void
+      prepare_boundary_error(const std::vector<std::array<std::uint32_t, 3>> &faces) const
+      {
+        face_normals.clear();
+        face_samples.clear();
+        for (const auto &f : faces)
+        {
+          face_normals.push_back(
+            unit_normal(position[f[0]], position[f[1]], position[f[2]]));
+          const auto found = face_points.find(key3(f[0], f[1], f[2]));
+          face_samples.push_back(found != face_points.end() ? &found->second : nullptr);
+        }
+      }
+
+      /**
        * Largest distance from the input boundary samples around @p v to the boundary
        * after collapsing v onto @p w; infinite if a face would turn over or the
        * distance exceeds @p give_up (then the exact value does not matter).
+       * @p faces are v's boundary faces, given to prepare_boundary_error() before.
        */
       double
       boundary_error(const std::uint32_t                              v,
@@ -450,43 +475,53 @@ namespace lacerta::mt
       {
         auto &after = moved_faces;
         after.clear();
-        for (const auto &f : faces)
+        // Per face of v, its moved face in after (none: it disappears).
+        moved_index.assign(faces.size(), none);
+        for (std::size_t i = 0; i < faces.size(); ++i)
+        {
+          const auto &f = faces[i];
           if (std::find(f.begin(), f.end(), w) == f.end())
           {
             std::array<Point3, 3> moved;
-            for (unsigned int i = 0; i < 3; ++i)
-              moved[i] = position[f[i] == v ? w : f[i]];
-            const Point3 old_normal =
-              unit_normal(position[f[0]], position[f[1]], position[f[2]]);
+            for (unsigned int k = 0; k < 3; ++k)
+              moved[k] = position[f[k] == v ? w : f[k]];
             const Point3 new_normal = unit_normal(moved[0], moved[1], moved[2]);
-            if (dot(old_normal, new_normal) < 0.5)
+            if (dot(face_normals[i], new_normal) < 0.5)
               return std::numeric_limits<double>::infinity();
+            moved_index[i] = static_cast<std::uint32_t>(after.size());
             after.push_back(moved);
           }
+        }
         if (after.empty())
           return std::numeric_limits<double>::infinity();
         // The distance of a sample only matters if it raises the maximum so far: the
-        // search over faces stops at the first face closer than that.
+        // search over faces stops at the first face closer than that. A sample is
+        // usually nearest to the moved version of the face it is attached to, so that
+        // face is tried first; the minimum, hence the result, does not depend on the
+        // order.
         double     error   = 0;
-        const auto include = [&](const Point3 &p)
+        const auto include = [&](const Point3 &p, const std::uint32_t first)
         {
           double d = std::numeric_limits<double>::infinity();
+          if (first != none)
+          {
+            const auto &f = after[first];
+            if ((d = point_triangle_distance(p, f[0], f[1], f[2])) <= error)
+              return true;
+          }
           for (const auto &f : after)
             if ((d = std::min(d, point_triangle_distance(p, f[0], f[1], f[2]))) <= error)
               return true;
           error = d;
           return error <= give_up;
         };
-        if (!include(position[v]))
+        if (!include(position[v], none))
           return std::numeric_limits<double>::infinity();
-        for (const auto &f : faces)
-        {
-          const auto found = face_points.find(key3(f[0], f[1], f[2]));
-          if (found != face_points.end())
-            for (const std::uint32_t p : found->second)
-              if (!include(position[p]))
+        for (std::size_t i = 0; i < faces.size(); ++i)
+          if (face_samples[i] != nullptr)
+            for (const std::uint32_t p : *face_samples[i])
+              if (!include(position[p], moved_index[i]))
                 return std::numeric_limits<double>::infinity();
-        }
         return error;
       }
 
@@ -524,6 +559,7 @@ namespace lacerta::mt
 
         auto &faces = faces_v;
         boundary_faces(v, faces);
+        prepare_boundary_error(faces);
         double best_quality = -1;
         for (const std::uint32_t w : around)
         {
@@ -580,7 +616,7 @@ namespace lacerta::mt
             continue;
           if (priority == best.priority && quality <= best_quality)
             continue;
-          if (!link_condition(v, w))
+          if (!link_condition(v, faces, w))
             continue;
           best         = {w, priority, error};
           best_quality = quality;
@@ -709,9 +745,12 @@ namespace lacerta::mt
       mutable std::vector<std::array<std::uint32_t, 4>> cells_v, cells_w;
       mutable std::vector<std::uint64_t> edges_vw, edges_v, edges_w, triangles_v,
         triangles_w;
-      mutable std::vector<std::uint32_t>         around_scratch;
-      mutable std::vector<std::array<Point3, 3>> moved_faces;
-      std::priority_queue<Entry>                 queue;
+      mutable std::vector<std::uint32_t>                      around_scratch;
+      mutable std::vector<std::array<Point3, 3>>              moved_faces;
+      mutable std::vector<std::uint32_t>                      moved_index;
+      mutable std::vector<Point3>                             face_normals;
+      mutable std::vector<const std::vector<std::uint32_t> *> face_samples;
+      std::priority_queue<Entry>                              queue;
       // The record: collapse k removed vertex removed_vertex[k], removed the tets from
       // removed_begin[k] and created those from created_begin[k].
       std::vector<std::uint32_t> removed_vertex, removed_begin, removed_list,
