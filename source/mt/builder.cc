@@ -122,17 +122,12 @@ namespace lacerta::mt
       list.erase(std::unique(list.begin(), list.end()), list.end());
     }
 
-    /// Whether the sorted lists @p a and @p b have exactly the common entries @p c.
-    template <typename T>
+    /// Whether the short list @p list holds @p key (lists of a few entries: a linear
+    /// scan beats sorting or hashing them).
     bool
-    intersection_equals(const std::vector<T> &a,
-                        const std::vector<T> &b,
-                        const std::vector<T> &c)
+    holds(const std::vector<std::uint64_t> &list, const std::uint64_t key)
     {
-      std::vector<T> common;
-      std::set_intersection(
-        a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(common));
-      return common == c;
+      return std::find(list.begin(), list.end(), key) != list.end();
     }
 
     /// A candidate collapse of a vertex.
@@ -170,6 +165,7 @@ namespace lacerta::mt
                       "' has ",
                       position.size(),
                       " vertices; the builder handles fewer than 2^21.");
+        mark.assign(position.size() + 1, 0);
         for (std::uint32_t t = 0; t < tets.size(); ++t)
           for (const unsigned int v : tets[t])
             star[v].push_back(t);
@@ -240,11 +236,21 @@ namespace lacerta::mt
         }
       };
 
-      /// Outward oriented boundary faces around @p v, from its star.
-      std::vector<std::array<std::uint32_t, 3>>
-      boundary_faces(const std::uint32_t v) const
+      /**
+       * Outward oriented boundary faces around @p v, from its star, in @p result
+       * (sorted by key3, an order the sample assignment of collapse() depends on). An
+       * interior vertex has none and never gets any (a new boundary face would come from
+       * an old one through v), so it costs nothing.
+       */
+      void
+      boundary_faces(const std::uint32_t                        v,
+                     std::vector<std::array<std::uint32_t, 3>> &result) const
       {
-        std::vector<std::pair<std::uint64_t, std::array<std::uint32_t, 3>>> faces;
+        result.clear();
+        if (!boundary[v])
+          return;
+        auto &faces = face_scratch;
+        faces.clear();
         for (const std::uint32_t t : star[v])
           for (unsigned int f = 0; f < 4; ++f)
             if (tets[t][f] != v)
@@ -257,7 +263,6 @@ namespace lacerta::mt
         std::sort(faces.begin(),
                   faces.end(),
                   [](const auto &a, const auto &b) { return a.first < b.first; });
-        std::vector<std::array<std::uint32_t, 3>> result;
         for (std::size_t i = 0; i < faces.size();)
         {
           std::size_t j = i;
@@ -267,7 +272,6 @@ namespace lacerta::mt
             result.push_back(faces[i].second);
           i = j;
         }
-        return result;
       }
 
       /**
@@ -290,67 +294,89 @@ namespace lacerta::mt
         return true;
       }
 
-      /// The vertices sharing a tetrahedron with @p v.
-      std::vector<std::uint32_t>
-      neighbours(const std::uint32_t v) const
+      /// A fresh value for mark[]: no entry holds it yet.
+      std::uint32_t
+      new_mark() const
       {
-        std::vector<std::uint32_t> list;
+        if (++mark_value == 0)
+        {
+          std::fill(mark.begin(), mark.end(), 0);
+          mark_value = 1;
+        }
+        return mark_value;
+      }
+
+      /// The vertices sharing a tetrahedron with @p v, sorted (the candidates are
+      /// tried in this order, which breaks ties), in @p list.
+      void
+      neighbours(const std::uint32_t v, std::vector<std::uint32_t> &list) const
+      {
+        list.clear();
+        const std::uint32_t seen = new_mark();
+        mark[v]                  = seen;
         for (const std::uint32_t t : star[v])
           for (const unsigned int u : tets[t])
-            if (u != v)
+            if (mark[u] != seen)
+            {
+              mark[u] = seen;
               list.push_back(u);
-        sort_unique(list);
-        return list;
+            }
+        std::sort(list.begin(), list.end());
+      }
+
+      /**
+       * The cells around @p u in the mesh closed by the ghost vertex, in @p cells;
+       * @p faces are u's boundary faces.
+       */
+      void
+      closed_star(const std::uint32_t                              u,
+                  const std::vector<std::array<std::uint32_t, 3>> &faces,
+                  std::vector<std::array<std::uint32_t, 4>>       &cells) const
+      {
+        cells.clear();
+        for (const std::uint32_t t : star[u])
+          cells.push_back(tets[t]);
+        for (const auto &f : faces)
+          cells.push_back({{ghost, f[0], f[1], f[2]}});
       }
 
       /**
        * The link condition Lk(v) ∩ Lk(w) = Lk(vw) on the mesh closed by a ghost vertex
        * joined to every boundary face: it keeps the mesh a manifold and the boundary's
        * topology unchanged.
+       *
+       * Lk(vw) is always part of both links, so the condition is on the common
+       * simplices only. It is checked with marks, without building or sorting the
+       * links (this test runs for every candidate that passes the quality test):
+       * common vertices = the ring of vertices around edge vw; then every common edge
+       * or triangle has its vertices in that ring, a handful, so those are compared in
+       * short lists. @p faces_of_v are v's boundary faces (the caller has them).
        */
       bool
-      link_condition(const std::uint32_t v, const std::uint32_t w) const
+      link_condition(const std::uint32_t                              v,
+                     const std::vector<std::array<std::uint32_t, 3>> &faces_of_v,
+                     const std::uint32_t                              w) const
       {
-        std::vector<std::array<std::uint32_t, 4>> cells_v, cells_w;
-        const auto                                gather =
-          [&](const std::uint32_t u, std::vector<std::array<std::uint32_t, 4>> &cells)
-        {
-          for (const std::uint32_t t : star[u])
-            cells.push_back(tets[t]);
-          for (const auto &f : boundary_faces(u))
-            cells.push_back({{ghost, f[0], f[1], f[2]}});
-        };
-        gather(v, cells_v);
-        gather(w, cells_w);
-        struct Link
-        {
-          std::vector<std::uint64_t> vertices, edges, triangles;
-        };
-        const auto link = [](const std::vector<std::array<std::uint32_t, 4>> &cells,
-                             const std::uint32_t                              u)
-        {
-          Link l;
-          for (const auto &c : cells)
-          {
-            std::array<std::uint32_t, 3> o{};
-            unsigned int                 n = 0;
-            for (const std::uint32_t x : c)
-              if (x != u)
-                o[n++] = x;
-            l.triangles.push_back(key3(o[0], o[1], o[2]));
-            for (unsigned int i = 0; i < 3; ++i)
+        closed_star(v, faces_of_v, cells_v);
+        boundary_faces(w, ghost_faces);
+        closed_star(w, ghost_faces, cells_w);
+        // Vertices: mark Lk(v), promote those also in Lk(w) (common), then those of
+        // Lk(vw) (ring); the condition holds when every common vertex is in the ring
+        // and every ring vertex is common.
+        const std::uint32_t in_v = new_mark(), common = new_mark(), ring = new_mark();
+        for (const auto &c : cells_v)
+          for (const std::uint32_t x : c)
+            if (x != v)
+              mark[x] = in_v;
+        unsigned int n_common = 0, n_ring = 0;
+        for (const auto &c : cells_w)
+          for (const std::uint32_t x : c)
+            if (x != w && mark[x] == in_v)
             {
-              l.vertices.push_back(o[i]);
-              l.edges.push_back(key2(o[i], o[(i + 1) % 3]));
+              mark[x] = common;
+              ++n_common;
             }
-          }
-          sort_unique(l.vertices);
-          sort_unique(l.edges);
-          sort_unique(l.triangles);
-          return l;
-        };
-        const Link lv = link(cells_v, v), lw = link(cells_w, w);
-        Link       le;
+        edges_vw.clear();
         for (const auto &c : cells_v)
           if (std::find(c.begin(), c.end(), w) != c.end())
           {
@@ -359,21 +385,87 @@ namespace lacerta::mt
             for (const std::uint32_t x : c)
               if (x != v && x != w)
                 o[n++] = x;
-            le.vertices.push_back(o[0]);
-            le.vertices.push_back(o[1]);
-            le.edges.push_back(key2(o[0], o[1]));
+            for (const std::uint32_t x : o)
+              if (mark[x] == common)
+              {
+                mark[x] = ring;
+                ++n_ring;
+              }
+              else if (mark[x] != ring)
+                return false;
+            edges_vw.push_back(key2(o[0], o[1]));
           }
-        sort_unique(le.vertices);
-        sort_unique(le.edges);
-        return intersection_equals(lv.vertices, lw.vertices, le.vertices)
-               && intersection_equals(lv.edges, lw.edges, le.edges)
-               && intersection_equals(lv.triangles, lw.triangles, le.triangles);
+        if (n_common != n_ring)
+          return false;
+        // Edges and triangles of each link with all their vertices in the ring: the
+        // only ones that can be common.
+        const auto ring_parts =
+          [&](const std::vector<std::array<std::uint32_t, 4>> &cells,
+              const std::uint32_t                              u,
+              std::vector<std::uint64_t>                      &edges,
+              std::vector<std::uint64_t>                      &triangles)
+        {
+          edges.clear();
+          triangles.clear();
+          for (const auto &c : cells)
+          {
+            std::array<std::uint32_t, 3> o{};
+            unsigned int                 n = 0;
+            for (const std::uint32_t x : c)
+              if (x != u)
+                o[n++] = x;
+            if (n != 3)
+              continue;
+            unsigned int n_in = 0;
+            for (unsigned int i = 0; i < 3; ++i)
+              if (mark[o[i]] == ring)
+              {
+                ++n_in;
+                if (mark[o[(i + 1) % 3]] == ring)
+                  edges.push_back(key2(o[i], o[(i + 1) % 3]));
+              }
+            if (n_in == 3)
+              triangles.push_back(key3(o[0], o[1], o[2]));
+          }
+        };
+        ring_parts(cells_v, v, edges_v, triangles_v);
+        ring_parts(cells_w, w, edges_w, triangles_w);
+        // Common edges = Lk(vw)'s edges; no common triangle (Lk(vw) has none).
+        for (const std::uint64_t e : edges_vw)
+          if (!holds(edges_v, e) || !holds(edges_w, e))
+            return false;
+        for (const std::uint64_t e : edges_v)
+          if (holds(edges_w, e) && !holds(edges_vw, e))
+            return false;
+        for (const std::uint64_t t : triangles_v)
+          if (holds(triangles_w, t))
+            return false;
+        return true;
+      }
+
+      /**
+       * Prepares boundary_error() for vertex @p v, whose boundary faces are
+       * @p faces: their normals and samples do not depend on the candidate target.
+       */
+      void
+      prepare_boundary_error(const std::vector<std::array<std::uint32_t, 3>> &faces) const
+      {
+        face_normals.clear();
+        face_samples.clear();
+        for (const auto &f : faces)
+        {
+          face_normals.push_back(
+            unit_normal(position[f[0]], position[f[1]], position[f[2]]));
+          const auto found = face_points.find(key3(f[0], f[1], f[2]));
+          face_samples.push_back(found != face_points.end() ? &found->second : nullptr);
+        }
       }
 
       /**
        * Largest distance from the input boundary samples around @p v to the boundary
        * after collapsing v onto @p w; infinite if a face would turn over or the
        * distance exceeds @p give_up (then the exact value does not matter).
+       * @p faces are v's boundary faces, given to prepare_boundary_error() before.
        */
       double
       boundary_error(const std::uint32_t                              v,
@@ -381,44 +473,55 @@ namespace lacerta::mt
                      const std::vector<std::array<std::uint32_t, 3>> &faces,
                      const double                                     give_up) const
       {
-        std::vector<std::array<Point3, 3>> after;
-        for (const auto &f : faces)
+        auto &after = moved_faces;
+        after.clear();
+        // Per face of v, its moved face in after (none: it disappears).
+        moved_index.assign(faces.size(), none);
+        for (std::size_t i = 0; i < faces.size(); ++i)
+        {
+          const auto &f = faces[i];
           if (std::find(f.begin(), f.end(), w) == f.end())
           {
             std::array<Point3, 3> moved;
-            for (unsigned int i = 0; i < 3; ++i)
-              moved[i] = position[f[i] == v ? w : f[i]];
-            const Point3 old_normal =
-              unit_normal(position[f[0]], position[f[1]], position[f[2]]);
+            for (unsigned int k = 0; k < 3; ++k)
+              moved[k] = position[f[k] == v ? w : f[k]];
             const Point3 new_normal = unit_normal(moved[0], moved[1], moved[2]);
-            if (dot(old_normal, new_normal) < 0.5)
+            if (dot(face_normals[i], new_normal) < 0.5)
               return std::numeric_limits<double>::infinity();
+            moved_index[i] = static_cast<std::uint32_t>(after.size());
             after.push_back(moved);
           }
+        }
         if (after.empty())
           return std::numeric_limits<double>::infinity();
         // The distance of a sample only matters if it raises the maximum so far: the
-        // search over faces stops at the first face closer than that.
+        // search over faces stops at the first face closer than that. A sample is
+        // usually nearest to the moved version of the face it is attached to, so that
+        // face is tried first; the minimum, hence the result, does not depend on the
+        // order.
         double     error   = 0;
-        const auto include = [&](const Point3 &p)
+        const auto include = [&](const Point3 &p, const std::uint32_t first)
         {
           double d = std::numeric_limits<double>::infinity();
+          if (first != none)
+          {
+            const auto &f = after[first];
+            if ((d = point_triangle_distance(p, f[0], f[1], f[2])) <= error)
+              return true;
+          }
           for (const auto &f : after)
             if ((d = std::min(d, point_triangle_distance(p, f[0], f[1], f[2]))) <= error)
               return true;
           error = d;
           return error <= give_up;
         };
-        if (!include(position[v]))
+        if (!include(position[v], none))
           return std::numeric_limits<double>::infinity();
-        for (const auto &f : faces)
-        {
-          const auto found = face_points.find(key3(f[0], f[1], f[2]));
-          if (found != face_points.end())
-            for (const std::uint32_t p : found->second)
-              if (!include(position[p]))
+        for (std::size_t i = 0; i < faces.size(); ++i)
+          if (face_samples[i] != nullptr)
+            for (const std::uint32_t p : *face_samples[i])
+              if (!include(position[p], moved_index[i]))
                 return std::numeric_limits<double>::infinity();
-        }
         return error;
       }
 
@@ -439,15 +542,24 @@ namespace lacerta::mt
                                         position[tets[t][2]],
                                         position[tets[t][3]]);
         volume /= star[v].size();
-        const std::vector<std::uint32_t> around    = neighbours(v);
-        double                           mean_edge = 0;
+        // The priority of an interior vertex is its volume whatever the target: a queue
+        // entry needs no candidate list.
+        if (!boundary[v] && !full)
+        {
+          const Tet &t = tets[star[v][0]];
+          best         = {t[0] != v ? t[0] : t[1], volume, 0};
+          return best;
+        }
+        auto &around = around_scratch;
+        neighbours(v, around);
+        double mean_edge = 0;
         for (const std::uint32_t u : around)
           mean_edge += distance(position[u], position[v]);
         mean_edge /= around.size();
 
-        std::vector<std::array<std::uint32_t, 3>> faces;
-        if (boundary[v])
-          faces = boundary_faces(v);
+        auto &faces = faces_v;
+        boundary_faces(v, faces);
+        prepare_boundary_error(faces);
         double best_quality = -1;
         for (const std::uint32_t w : around)
         {
@@ -504,7 +616,7 @@ namespace lacerta::mt
             continue;
           if (priority == best.priority && quality <= best_quality)
             continue;
-          if (!link_condition(v, w))
+          if (!link_condition(v, faces, w))
             continue;
           best         = {w, priority, error};
           best_quality = quality;
@@ -527,7 +639,8 @@ namespace lacerta::mt
         if (boundary[v])
         {
           // The samples around v go to their nearest face of the new boundary.
-          const auto                 faces = boundary_faces(v);
+          std::vector<std::array<std::uint32_t, 3>> faces;
+          boundary_faces(v, faces);
           std::vector<std::uint32_t> samples;
           if (v < n_input_samples())
             samples.push_back(v);
@@ -622,7 +735,22 @@ namespace lacerta::mt
       std::uint32_t                           ghost;
       double                                  max_distance = 0;
       std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> face_points;
-      std::priority_queue<Entry>                                    queue;
+      // Scratch of the candidate evaluation, reused so that the search allocates
+      // nothing once the buffers have grown (mutable: the evaluation is logically const).
+      mutable std::vector<std::uint32_t> mark;
+      mutable std::uint32_t              mark_value = 0;
+      mutable std::vector<std::pair<std::uint64_t, std::array<std::uint32_t, 3>>>
+                                                        face_scratch;
+      mutable std::vector<std::array<std::uint32_t, 3>> faces_v, ghost_faces;
+      mutable std::vector<std::array<std::uint32_t, 4>> cells_v, cells_w;
+      mutable std::vector<std::uint64_t> edges_vw, edges_v, edges_w, triangles_v,
+        triangles_w;
+      mutable std::vector<std::uint32_t>                      around_scratch;
+      mutable std::vector<std::array<Point3, 3>>              moved_faces;
+      mutable std::vector<std::uint32_t>                      moved_index;
+      mutable std::vector<Point3>                             face_normals;
+      mutable std::vector<const std::vector<std::uint32_t> *> face_samples;
+      std::priority_queue<Entry>                              queue;
       // The record: collapse k removed vertex removed_vertex[k], removed the tets from
       // removed_begin[k] and created those from created_begin[k].
       std::vector<std::uint32_t> removed_vertex, removed_begin, removed_list,

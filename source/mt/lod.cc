@@ -2,6 +2,8 @@
 #include <lacerta/mt/lod_query.h>
 
 #include <algorithm>
+#include <cmath>
+#include <functional>
 
 namespace lacerta::mt
 {
@@ -14,6 +16,8 @@ namespace lacerta::mt
       , active_fine(mt.n_nodes(), 0)
       , need_stamp(mt.n_nodes(), 0)
       , need_value(mt.n_nodes(), 0)
+      , frontier_position(mt.n_nodes(), mesh::invalid_index)
+      , check_at(mt.n_nodes(), 0)
   {
     applied[0] = 1;
     for (std::uint32_t t = mt.fine_begin[0]; t < mt.fine_begin[1]; ++t)
@@ -27,8 +31,12 @@ namespace lacerta::mt
     position[t] = static_cast<std::uint32_t>(active.size());
     active.push_back(t);
     ++active_fine[mt->creator[t]];
+    update_frontier(mt->creator[t]);
     if (mt->destroyer[t] != mesh::invalid_index)
+    {
       ++active_coarse[mt->destroyer[t]];
+      update_frontier(mt->destroyer[t]);
+    }
   }
 
 
@@ -41,8 +49,57 @@ namespace lacerta::mt
     active.pop_back();
     position[t] = mesh::invalid_index;
     --active_fine[mt->creator[t]];
+    update_frontier(mt->creator[t]);
     if (mt->destroyer[t] != mesh::invalid_index)
+    {
       --active_coarse[mt->destroyer[t]];
+      update_frontier(mt->destroyer[t]);
+    }
+  }
+
+
+  bool
+  Lod::on_frontier(const std::uint32_t j) const
+  {
+    return j != 0
+           && (active_coarse[j] == mt->n_coarse(j) || active_fine[j] == mt->n_fine(j));
+  }
+
+
+  void
+  Lod::update_frontier(const std::uint32_t j)
+  {
+    const bool in = frontier_position[j] != mesh::invalid_index;
+    if (on_frontier(j) == in)
+      return;
+    if (!in)
+    {
+      frontier_position[j] = static_cast<std::uint32_t>(frontier.size());
+      frontier.push_back(j);
+      joined.push_back(j);
+    }
+    else
+    {
+      const std::uint32_t last       = frontier.back();
+      frontier[frontier_position[j]] = last;
+      frontier_position[last]        = frontier_position[j];
+      frontier_position[j]           = mesh::invalid_index;
+      frontier.pop_back();
+    }
+  }
+
+
+  void
+  Lod::schedule_check(const std::uint32_t j, const LodQuery &query)
+  {
+    const auto  &b     = mt->ball[j];
+    const double slack = query.focus_slack({{b[0], b[1], b[2]}}, b[3], mt->error[j]);
+    check_at[j]        = query.focus_travel() + slack;
+    if (std::isfinite(check_at[j]))
+    {
+      checks.push_back({check_at[j], j});
+      std::push_heap(checks.begin(), checks.end(), std::greater<>());
+    }
   }
 
 
@@ -97,18 +154,39 @@ namespace lacerta::mt
     }
     n_last_applied = n_last_undone = 0;
 
-    // The frontier: nodes whose coarse fragment is all active (can be applied) and
-    // applied nodes whose fine fragment is all active (can be undone). Every active tet
-    // points to one of each kind.
-    std::vector<std::uint32_t> to_apply, to_undo;
-    for (const std::uint32_t t : active)
+    // The frontier nodes whose need may have changed: all of them for a new query;
+    // otherwise those that joined the frontier since their last test and those whose
+    // slack the focus has travelled past (the others keep their need: they stay).
+    std::vector<std::uint32_t> candidates;
+    const double               travel = query.focus_travel();
+    if (query.identity() != query_identity)
     {
-      const std::uint32_t d = mt->destroyer[t], c = mt->creator[t];
-      if (d != mesh::invalid_index && active_coarse[d] == mt->n_coarse(d)
-          && needs(d, query))
-        to_apply.push_back(d);
-      if (c != 0 && active_fine[c] == mt->n_fine(c) && !needs(c, query))
-        to_undo.push_back(c);
+      query_identity = query.identity();
+      candidates     = frontier;
+      checks.clear();
+    }
+    else
+    {
+      candidates = joined;
+      while (!checks.empty() && checks.front().first <= travel)
+      {
+        const auto [at, j] = checks.front();
+        std::pop_heap(checks.begin(), checks.end(), std::greater<>());
+        checks.pop_back();
+        if (check_at[j] == at && frontier_position[j] != mesh::invalid_index)
+          candidates.push_back(j);
+      }
+    }
+    joined.clear();
+    std::vector<std::uint32_t> to_apply, to_undo;
+    for (const std::uint32_t j : candidates)
+    {
+      if (frontier_position[j] == mesh::invalid_index)
+        continue;
+      if (active_coarse[j] == mt->n_coarse(j) && needs(j, query))
+        to_apply.push_back(j);
+      else if (active_fine[j] == mt->n_fine(j) && !needs(j, query))
+        to_undo.push_back(j);
     }
     // Undo first: a node without need has no descendant with need, so nothing undone
     // here is a parent of a node applied below.
@@ -142,6 +220,26 @@ namespace lacerta::mt
             && needs(c, query))
           to_apply.push_back(c);
       }
+    }
+    // Every frontier node is now stable (applicable ones not needed, undoable ones
+    // needed); those tested or new in this call wait for their slack. Stale entries
+    // are dropped when they outnumber the frontier.
+    for (const std::uint32_t j : candidates)
+      if (frontier_position[j] != mesh::invalid_index)
+        schedule_check(j, query);
+    for (const std::uint32_t j : joined)
+      if (frontier_position[j] != mesh::invalid_index)
+        schedule_check(j, query);
+    joined.clear();
+    if (checks.size() > 4 * frontier.size() + 1024)
+    {
+      std::vector<std::pair<double, std::uint32_t>> kept;
+      for (const auto &entry : checks)
+        if (check_at[entry.second] == entry.first
+            && frontier_position[entry.second] != mesh::invalid_index)
+          kept.push_back(entry);
+      checks.swap(kept);
+      std::make_heap(checks.begin(), checks.end(), std::greater<>());
     }
     return n_last_applied + n_last_undone > 0;
   }

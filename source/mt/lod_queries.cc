@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace lacerta::mt
 {
@@ -35,6 +36,13 @@ namespace lacerta::mt
       minimum_error(const mesh::Point3 &, double) const override
       {
         return error;
+      }
+
+      double
+      focus_slack(const mesh::Point3 &, double, double) const override
+      {
+        // No focus: the answer never changes.
+        return std::numeric_limits<double>::infinity();
       }
 
     private:
@@ -81,7 +89,35 @@ namespace lacerta::mt
       void
       set_focus(const mesh::Point3 &point) override
       {
+        travel += distance_to(point);
         focus = point;
+      }
+
+      double
+      focus_travel() const override
+      {
+        return travel;
+      }
+
+      double
+      focus_slack(const mesh::Point3 &center,
+                  const double        ball_radius,
+                  const double        error) const override
+      {
+        // The answer depends on the focus through its distance to the center only, and
+        // minimum_error < error exactly when that distance is below D = ball_radius +
+        // radius + (h - h0) / growth, h the cell size of the error: the focus must
+        // travel at least |distance - D| to change it. The margin covers rounding (h
+        // from the error by a cube root).
+        const double h = std::cbrt(error * 6 * std::sqrt(2.0));
+        if (growth == 0 || h < near_size * (1 - 1e-9))
+          return std::numeric_limits<double>::infinity(); // never changes
+        if (h <= near_size)
+          return 0; // too close to call
+
+        const double critical = ball_radius + radius + (h - near_size) / growth;
+        const double slack    = std::abs(distance_to(center) - critical);
+        return std::max(0.0, slack - 1e-9 * (1 + critical));
       }
 
       double
@@ -89,16 +125,18 @@ namespace lacerta::mt
       {
         // The allowed error grows with the distance, so its minimum over the ball is at
         // the ball's point nearest to the focus.
-        const double d = std::max(0.0,
-                                  std::hypot(center[0] - focus[0],
-                                             center[1] - focus[1],
-                                             center[2] - focus[2])
-                                    - ball_radius);
+        const double d = std::max(0.0, distance_to(center) - ball_radius);
         return error_of_cell_size(near_size + growth * std::max(0.0, d - radius));
       }
 
     private:
-      double       radius = 0, near_size = 0, growth = 0;
+      double
+      distance_to(const mesh::Point3 &point) const
+      {
+        return std::hypot(point[0] - focus[0], point[1] - focus[1], point[2] - focus[2]);
+      }
+
+      double       radius = 0, near_size = 0, growth = 0, travel = 0;
       mesh::Point3 focus = {{0, 0, 0}};
     };
   } // namespace

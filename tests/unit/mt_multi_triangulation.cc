@@ -295,6 +295,85 @@ namespace lacerta
   }
 
 
+  // Small steps exercise the skipping of frontier nodes whose slack the focus has not
+  // travelled yet; a nonzero cell size near the focus makes some nodes never needed.
+  TEST(MultiTriangulation, IncrementalExtractionWithSmallStepsEqualsExtractionFromScratch)
+  {
+    const auto &mt = box_mt();
+    for (const std::string near : {"0", "0.1"})
+    {
+      auto    query = make_query("focus",
+                              {{"Radius", "0.1"},
+                                  {"Cell size growth", "0.5"},
+                                  {"Cell size near the focus", near}});
+      mt::Lod incremental(mt);
+      for (int step = 0; step <= 150; ++step)
+      {
+        query->set_focus({{0.007 * step, 0.5 + 0.2 * std::sin(0.05 * step), 0.4}});
+        incremental.extract(*query);
+        mt::Lod scratch(mt);
+        scratch.extract(*query);
+        for (unsigned int j = 0; j < mt.n_nodes(); ++j)
+          ASSERT_EQ(incremental.is_applied(j), scratch.is_applied(j))
+            << "node " << j << ", step " << step << ", near size " << near;
+      }
+      // Another query object: everything is tested again.
+      const auto uniform = make_query("uniform", {{"Cell size", "0.3"}});
+      incremental.extract(*uniform);
+      mt::Lod scratch(mt);
+      scratch.extract(*uniform);
+      ASSERT_EQ(active_set(mt, incremental), active_set(mt, scratch));
+    }
+  }
+
+
+  // The slack of the focus query is a true lower bound: a focus that moves less than it
+  // leaves the answer of the query for that ball and error unchanged.
+  TEST(MultiTriangulation, FocusSlackIsALowerBound)
+  {
+    auto query = make_query("focus", {{"Radius", "0.1"}, {"Cell size growth", "0.5"}});
+    unsigned int seed    = 12345;
+    const auto   uniform = [&seed]()
+    {
+      seed = seed * 1103515245u + 12345u;
+      return (seed >> 8) / double(1u << 24);
+    };
+    unsigned int n_finite = 0;
+    for (int trial = 0; trial < 2000; ++trial)
+    {
+      const Point3 focus  = {{uniform(), uniform(), uniform()}};
+      const Point3 center = {{uniform(), uniform(), uniform()}};
+      const double radius = 0.2 * uniform();
+      const double error  = mt::LodQuery::error_of_cell_size(0.3 * uniform());
+      query->set_focus(focus);
+      const bool   before = query->minimum_error(center, radius) < error;
+      const double slack  = query->focus_slack(center, radius, error);
+      ASSERT_GE(slack, 0);
+      if (!std::isfinite(slack))
+        continue;
+      ++n_finite;
+      // Move by just under the slack in a random direction and towards the center.
+      for (int k = 0; k < 2; ++k)
+      {
+        Point3 direction =
+          k == 0
+            ? Point3{{uniform() - 0.5, uniform() - 0.5, uniform() - 0.5}}
+            : Point3{{center[0] - focus[0], center[1] - focus[1], center[2] - focus[2]}};
+        const double length = std::hypot(direction[0], direction[1], direction[2]);
+        if (length == 0)
+          continue;
+        Point3 moved = focus;
+        for (unsigned int d = 0; d < 3; ++d)
+          moved[d] += 0.999 * slack * direction[d] / length;
+        query->set_focus(moved);
+        EXPECT_EQ(query->minimum_error(center, radius) < error, before)
+          << "trial " << trial;
+      }
+    }
+    EXPECT_GT(n_finite, 1000u);
+  }
+
+
   TEST(MultiTriangulation, NewParticlesLieInTetrahedraOfThePreviousLevel)
   {
     const auto &mt = box_mt();

@@ -36,8 +36,11 @@ namespace lacerta::mt
 
     /**
      * Updates to the level of detail @p query asks for, starting from the current one.
-     * The work is one test per active tetrahedron plus the nodes applied or undone:
-     * proportional to the current mesh and the change, not to the MT.
+     * Only the frontier nodes (those that can be applied or undone) can start a change;
+     * each one is tested again only once the focus has travelled the query's
+     * focus_slack() for it, so the work is proportional to the nodes near the edge of
+     * their need plus the nodes applied or undone, not to the current mesh nor the MT.
+     * Given another query object than last time, every frontier node is tested.
      * Returns whether anything changed.
      */
     bool
@@ -112,6 +115,20 @@ namespace lacerta::mt
     void
     toggle(std::uint32_t j);
 
+    /// Whether node @p j can be applied (its coarse fragment is all active) or undone
+    /// (its fine fragment is): only such nodes can start a change.
+    bool
+    on_frontier(std::uint32_t j) const;
+
+    /// Adds node @p j to or removes it from the frontier after a counter changed.
+    void
+    update_frontier(std::uint32_t j);
+
+    /// Queues frontier node @p j for a new test once the focus has travelled past
+    /// its slack.
+    void
+    schedule_check(std::uint32_t j, const LodQuery &query);
+
     const MultiTriangulation  *mt;
     std::vector<std::uint8_t>  applied;
     std::vector<std::uint8_t>  changed;
@@ -122,8 +139,18 @@ namespace lacerta::mt
     std::vector<std::uint32_t> active_fine;
     std::vector<std::uint32_t> need_stamp;
     std::vector<std::uint8_t>  need_value;
-    std::uint32_t              stamp          = 0;
-    unsigned int               n_last_applied = 0;
-    unsigned int               n_last_undone  = 0;
+    /// The frontier nodes, with each node's place in it (invalid_index: not in it).
+    std::vector<std::uint32_t> frontier;
+    std::vector<std::uint32_t> frontier_position;
+    /// Nodes that joined the frontier since their last test.
+    std::vector<std::uint32_t> joined;
+    /// Frontier tests due: (focus travel at which to test again, node), a min-heap;
+    /// an entry is stale unless check_at[node] still holds its travel.
+    std::vector<std::pair<double, std::uint32_t>> checks;
+    std::vector<double>                           check_at;
+    std::uint64_t                                 query_identity = 0;
+    std::uint32_t                                 stamp          = 0;
+    unsigned int                                  n_last_applied = 0;
+    unsigned int                                  n_last_undone  = 0;
   };
 } // namespace lacerta::mt

@@ -7,6 +7,7 @@
 #include <lacerta/base/plugins.h>
 #include <lacerta/mesh/tet_mesh.h>
 
+#include <cstdint>
 #include <string>
 
 namespace lacerta::mt
@@ -38,6 +39,32 @@ namespace lacerta::mt
     set_focus(const mesh::Point3 &focus);
 
     /**
+     * Length of the path the focus has travelled through set_focus() since the query
+     * was made; 0 for queries that ignore the focus. With focus_slack() it tells an
+     * incremental extraction which nodes cannot have changed.
+     */
+    virtual double
+    focus_travel() const;
+
+    /**
+     * A distance the focus may travel, from where it is now, before
+     * minimum_error(@p center, @p radius) can cross @p error in either direction
+     * (a lower bound; 0, the default, means "unknown: check every time"). A query
+     * must change only through set_focus() once it is used for extraction: a Lod
+     * relies on this to skip the nodes whose answer cannot have changed.
+     */
+    virtual double
+    focus_slack(const mesh::Point3 &center, double radius, double error) const;
+
+    /// A number no other query object made in this process has (Lod uses it to notice
+    /// that it is given a different query).
+    std::uint64_t
+    identity() const
+    {
+      return id;
+    }
+
+    /**
      * The smallest error the query allows in the ball of @p center and @p radius. It
      * must not increase when the ball grows, which makes extraction unique.
      */
@@ -47,6 +74,12 @@ namespace lacerta::mt
     /// The error of a regular tetrahedron of edge @p h.
     static double
     error_of_cell_size(double h);
+
+  private:
+    static std::uint64_t
+    next_identity();
+
+    std::uint64_t id = next_identity();
   };
 
   /// The registry of level of detail queries.
