@@ -93,14 +93,22 @@ namespace lacerta::fem
     void
     load(double t, VectorType &f) const;
 
-    /// Solves A u = f with u = u_D on the constrained dofs, A x computed by @p apply.
+    /**
+     * Solves A u = f with u = u_D on the constrained dofs: @p full is A without
+     * constraints, @p constrained A with them. @p u enters as the initial guess (its
+     * constrained entries are ignored) and leaves as the solution.
+     */
     void
-    solve(const MatrixType                                            &constrained,
-          const TrilinosWrappers::PreconditionBase                    &preconditioner,
-          const std::function<void(VectorType &, const VectorType &)> &apply,
-          const VectorType                                            &f,
-          const VectorType                                            &u_d,
-          VectorType                                                  &u);
+    solve(const MatrixType                         &constrained,
+          const TrilinosWrappers::PreconditionBase &preconditioner,
+          const MatrixType                         &full,
+          const VectorType                         &f,
+          const VectorType                         &u_d,
+          VectorType                               &u);
+
+    /// Makes @p v a vector of the owned dofs, allocating only if it is not one yet.
+    void
+    ensure_layout(VectorType &v) const;
 
     void
     make_amg(const MatrixType &matrix, TrilinosWrappers::PreconditionAMG &amg) const;
@@ -125,11 +133,19 @@ namespace lacerta::fem
     bool                                         stiffness_amg_ready = false;
     unsigned int                                 iterations          = 0;
 
-    // Newmark state.
-    double                            time_step = 0, time = 0;
-    MatrixType                        effective;
-    TrilinosWrappers::PreconditionAMG effective_amg;
-    VectorType                        u, v, a;
+    // Newmark state. The effective matrix (with and without constraints) and its AMG
+    // depend only on the time step: built once in start_dynamic(), reused every step.
+    double                               time_step = 0, time = 0;
+    MatrixType                           effective, effective_full;
+    TrilinosWrappers::PreconditionAMG    effective_amg;
+    TrilinosWrappers::PreconditionJacobi effective_jacobi;
+    // Which of the two preconditions the effective matrix (see start_dynamic()).
+    const TrilinosWrappers::PreconditionBase *effective_preconditioner = nullptr;
+    VectorType                                u, v, a;
+    // Work vectors of advance() and solve(), kept so that a time step allocates nothing.
+    VectorType rhs, work, damped, product, u_d, u_new, residual, correction;
+    // Per-vertex buffers of the Problem's callbacks (3 per vertex).
+    mutable std::vector<double> vertex_values;
   };
 
 
@@ -330,10 +346,12 @@ namespace lacerta::fem
   ElasticitySolver::Implementation::prescribed_values(const double t,
                                                       VectorType  &values) const
   {
-    values.reinit(owned, communicator);
+    ensure_layout(values);
+    values = 0;
     if (!problem.displacement)
       return;
-    std::vector<double> u(3 * problem.mesh->n_vertices(), 0.0);
+    std::vector<double> &u = vertex_values;
+    u.assign(3 * problem.mesh->n_vertices(), 0.0);
     problem.displacement(t, u);
     for (const auto &node : owned_nodes)
       if (constraints.is_constrained(node.dof))
@@ -349,7 +367,8 @@ namespace lacerta::fem
     f = body_load;
     if (!problem.point_forces)
       return;
-    std::vector<double> forces(3 * problem.mesh->n_vertices(), 0.0);
+    std::vector<double> &forces = vertex_values;
+    forces.assign(3 * problem.mesh->n_vertices(), 0.0);
     problem.point_forces(t, forces);
     for (const auto &node : owned_nodes)
       if (node.a == node.b)
@@ -377,29 +396,44 @@ namespace lacerta::fem
 
 
   void
-  ElasticitySolver::Implementation::solve(
-    const MatrixType                                            &constrained,
-    const TrilinosWrappers::PreconditionBase                    &preconditioner,
-    const std::function<void(VectorType &, const VectorType &)> &apply,
-    const VectorType                                            &f,
-    const VectorType                                            &u_d,
-    VectorType                                                  &result)
+  ElasticitySolver::Implementation::ensure_layout(VectorType &v) const
   {
-    // u = u_D + w with w = 0 on the constrained dofs: A_c w = f - A u_D there.
-    VectorType residual(owned, communicator);
-    apply(residual, u_d);
+    if (v.size() != dof_handler.n_dofs() || !(v.locally_owned_elements() == owned))
+      v.reinit(owned, communicator);
+  }
+
+
+  void
+  ElasticitySolver::Implementation::solve(
+    const MatrixType                         &constrained,
+    const TrilinosWrappers::PreconditionBase &preconditioner,
+    const MatrixType                         &full,
+    const VectorType                         &f,
+    const VectorType                         &u_d,
+    VectorType                               &result)
+  {
+    // u = u_D + w with w = 0 on the constrained dofs: A_c w = f - A u_D there. The
+    // guess for w is the incoming u minus u_D (a Newmark step passes its predictor).
+    ensure_layout(residual);
+    ensure_layout(correction);
+    ensure_layout(result);
+    full.vmult(residual, u_d);
     residual.sadd(-1.0, 1.0, f);
     constraints.set_zero(residual);
-    VectorType   w(owned, communicator);
+    // The tolerance is relative to this right-hand side, not to the initial residual:
+    // a good initial guess then saves iterations instead of tightening the goal.
     const double norm = residual.l2_norm();
-    iterations        = 0;
+    correction        = result;
+    correction -= u_d;
+    constraints.set_zero(correction);
+    iterations = 0;
     if (norm > 0)
     {
       SolverControl control(parameters.max_iterations, parameters.tolerance * norm);
       SolverCG<VectorType> cg(control);
       try
       {
-        cg.solve(constrained, w, residual, preconditioner);
+        cg.solve(constrained, correction, residual, preconditioner);
       }
       catch (const SolverControl::NoConvergence &e)
       {
@@ -413,9 +447,11 @@ namespace lacerta::fem
       }
       iterations = control.last_step();
     }
-    constraints.set_zero(w);
+    else
+      correction = 0;
+    constraints.set_zero(correction);
     result = u_d;
-    result += w;
+    result += correction;
   }
 
 
@@ -475,15 +511,16 @@ namespace lacerta::fem
     s.load(t, f);
     s.prescribed_values(t, u_d);
     s.u.reinit(s.owned, s.communicator);
-    s.solve(
-      s.constrained_stiffness,
-      s.stiffness_amg,
-      [&](VectorType &dst, const VectorType &src) { s.stiffness.vmult(dst, src); },
-      f,
-      u_d,
-      s.u);
+    s.solve(s.constrained_stiffness, s.stiffness_amg, s.stiffness, f, u_d, s.u);
     return s.gather(s.u);
   }
+
+
+  namespace
+  {
+    /// Up to this K_ii / ((4/dt²) M_ii), Newmark preconditions with Jacobi, not AMG.
+    constexpr double jacobi_stiffness_ratio = 100;
+  } // namespace
 
 
   void
@@ -494,9 +531,35 @@ namespace lacerta::fem
     s.time            = 0;
     const double a0 = 4 / (dt * dt), a1 = 2 / dt;
     const double c = s.problem.mass_damping, beta = s.problem.stiffness_damping;
-    // K_eff = K + (2/dt) C + (4/dt²) M with C = c M + β K.
+    // K_eff = K + (2/dt) C + (4/dt²) M with C = c M + β K, with the constraints (for CG
+    // and AMG) and without (to apply to the prescribed values).
     s.assemble_constrained(1 + a1 * beta, a0 + a1 * c, s.effective);
-    s.make_amg(s.effective, s.effective_amg);
+    s.effective_full.reinit(s.stiffness);
+    s.effective_full = 0;
+    s.effective_full.add(1 + a1 * beta, s.stiffness);
+    s.effective_full.add(a0 + a1 * c, s.mass);
+    // Which preconditioner: at the steps a Newmark run takes, (4/dt²) M dominates K,
+    // K_eff is about as well conditioned as M, and CG with Jacobi needs few iterations
+    // of one matrix product each, where every AMG cycle costs several products and a
+    // coarse direct solve. The largest ratio of the diagonals, K_ii / ((4/dt²) M_ii),
+    // bounds how far K shifts the spectrum; AMG only when it is large.
+    double stiffness_ratio = 0;
+    for (const auto &node : s.owned_nodes)
+      if (!s.constraints.is_constrained(node.dof))
+        stiffness_ratio = std::max(stiffness_ratio,
+                                   (1 + a1 * beta) * s.stiffness.diag_element(node.dof)
+                                     / ((a0 + a1 * c) * s.mass.diag_element(node.dof)));
+    stiffness_ratio = Utilities::MPI::max(stiffness_ratio, s.communicator);
+    if (stiffness_ratio < jacobi_stiffness_ratio)
+    {
+      s.effective_jacobi.initialize(s.effective);
+      s.effective_preconditioner = &s.effective_jacobi;
+    }
+    else
+    {
+      s.make_amg(s.effective, s.effective_amg);
+      s.effective_preconditioner = &s.effective_amg;
+    }
 
     s.prescribed_values(0, s.u);
     s.v.reinit(s.owned, s.communicator);
@@ -513,13 +576,7 @@ namespace lacerta::fem
     TrilinosWrappers::PreconditionJacobi jacobi;
     jacobi.initialize(constrained_mass);
     s.a.reinit(s.owned, s.communicator);
-    s.solve(
-      constrained_mass,
-      jacobi,
-      [&](VectorType &dst, const VectorType &src) { s.mass.vmult(dst, src); },
-      f,
-      zero,
-      s.a);
+    s.solve(constrained_mass, jacobi, s.mass, f, zero, s.a);
   }
 
 
@@ -534,52 +591,45 @@ namespace lacerta::fem
     const double t = s.time + dt;
 
     // rhs = f + M (a0 u + (4/dt) v + a) + C (a1 u + v).
-    VectorType rhs, tmp(s.owned, s.communicator), product(s.owned, s.communicator);
-    s.load(t, rhs);
-    tmp = s.u;
-    tmp *= a0;
-    tmp.add(4 / dt, s.v);
-    tmp += s.a;
-    VectorType damped = s.u;
-    damped *= a1;
-    damped += s.v;
-    tmp.add(c, damped);
-    s.mass.vmult(product, tmp);
-    rhs += product;
+    s.ensure_layout(s.work);
+    s.ensure_layout(s.damped);
+    s.ensure_layout(s.product);
+    s.load(t, s.rhs);
+    s.work = s.u;
+    s.work *= a0;
+    s.work.add(4 / dt, s.v);
+    s.work += s.a;
+    s.damped = s.u;
+    s.damped *= a1;
+    s.damped += s.v;
+    s.work.add(c, s.damped);
+    s.mass.vmult(s.product, s.work);
+    s.rhs += s.product;
     if (beta > 0)
     {
-      s.stiffness.vmult(product, damped);
-      rhs.add(beta, product);
+      s.stiffness.vmult(s.product, s.damped);
+      s.rhs.add(beta, s.product);
     }
 
-    VectorType u_d, u_new;
-    s.prescribed_values(t, u_d);
-    u_new.reinit(s.owned, s.communicator);
+    // Initial guess: the step with unchanged acceleration, u + dt v + dt²/2 a; CG then
+    // only corrects the change of acceleration.
+    s.prescribed_values(t, s.u_d);
+    s.ensure_layout(s.u_new);
+    s.u_new = s.u;
+    s.u_new.add(dt, s.v, dt * dt / 2, s.a);
     s.solve(
-      s.effective,
-      s.effective_amg,
-      [&](VectorType &dst, const VectorType &src)
-      {
-        VectorType mx(s.owned, s.communicator);
-        s.stiffness.vmult(dst, src);
-        dst *= 1 + a1 * beta;
-        s.mass.vmult(mx, src);
-        dst.add(a0 + a1 * c, mx);
-      },
-      rhs,
-      u_d,
-      u_new);
+      s.effective, *s.effective_preconditioner, s.effective_full, s.rhs, s.u_d, s.u_new);
 
-    // a_new = a0 (u_new - u) - (4/dt) v - a; v_new = v + dt/2 (a + a_new).
-    VectorType a_new = u_new;
-    a_new -= s.u;
-    a_new *= a0;
-    a_new.add(-4 / dt, s.v);
-    a_new -= s.a;
-    s.v.add(dt / 2, s.a);
-    s.v.add(dt / 2, a_new);
-    s.a    = a_new;
-    s.u    = u_new;
+    // a_new = a0 (u_new - u) - (4/dt) v - a; v_new = v + dt/2 (a + a_new). The work
+    // vector holds a_new.
+    s.work = s.u_new;
+    s.work -= s.u;
+    s.work *= a0;
+    s.work.add(-4 / dt, s.v);
+    s.work -= s.a;
+    s.v.add(dt / 2, s.a, dt / 2, s.work);
+    s.a.swap(s.work);
+    s.u.swap(s.u_new);
     s.time = t;
   }
 

@@ -20,9 +20,14 @@ namespace lacerta::fem
     problem.prescribed.resize(system.n_particles());
     for (unsigned int i = 0; i < system.n_particles(); ++i)
       problem.prescribed[i] = system.free[i] == 0;
-    problem.displacement = [&system](const double t, std::vector<double> &u)
+    // The buffers live in the callback, which a Newmark run calls every step.
+    problem.displacement =
+      [&system,
+       x = std::vector<double>(),
+       v = std::vector<double>()](const double t, std::vector<double> &u) mutable
     {
-      std::vector<double> x = system.rest_position(), v(x.size(), 0.0);
+      x = system.rest_position();
+      v.assign(x.size(), 0.0);
       system.enforce_constraints(t, x.data(), v.data());
       for (std::size_t k = 0; k < x.size(); ++k)
         u[k] = x[k] - system.rest_position()[k];

@@ -214,6 +214,13 @@ namespace lacerta::fem
                       dealii::Patterns::Integer(1, 10000),
                       "Dynamic analysis: the errors are taken over the nodes at this "
                       "many equally spaced times up to 'End time'.");
+    prm.declare_entry("Number of frequencies",
+                      "0",
+                      dealii::Patterns::Integer(0, 20),
+                      "How many of the lowest vibration frequencies (Hz, prescribed "
+                      "vertices held) to print for the reference and for every model "
+                      "and refinement: the springs linearised at rest against FEM. "
+                      "0: none.");
     prm.declare_entry("Plot",
                       "true",
                       dealii::Patterns::Bool(),
@@ -244,6 +251,7 @@ namespace lacerta::fem
     reference_refinement = prm.get_integer("Reference refinement");
     reference_time_step  = prm.get_double("Reference time step");
     n_samples            = prm.get_integer("Number of samples");
+    n_frequencies        = prm.get_integer("Number of frequencies");
     plot                 = prm.get_bool("Plot");
     plot_script          = prm.get("Plot script");
     prm.leave_subsection();
@@ -306,14 +314,43 @@ namespace lacerta::fem
     out << "Reference: largest vertex displacement " << std::setprecision(9) << largest
         << " m" << std::setprecision(6) << "\n";
 
+    // Frequencies at 4 digits: the subspace iteration converges to far better than
+    // that, so the printout is the same on any number of ranks.
+    const auto print_frequencies =
+      [&](const std::string &label, const std::vector<double> &frequencies)
+    {
+      out << "  frequencies [Hz] " << std::left << std::setw(27) << label
+          << std::setprecision(4);
+      for (const double f : frequencies)
+        out << ' ' << f;
+      out << std::setprecision(6) << "\n";
+    };
+    if (n_frequencies > 0)
+      print_frequencies("reference fem p2",
+                        reference_solver.lowest_frequencies(n_frequencies));
+
     std::vector<StudyRow> rows;
     for (const unsigned int refinement : refinements)
       for (const std::string &model : models)
       {
-        const bool  fem      = model.rfind("fem", 0) == 0;
-        const bool  fitted   = model == "fitted springs";
-        auto        scene    = make_scene(prm, refinement, fitted);
-        const auto &vertices = scene->mesh.get_vertices();
+        const bool fem    = model.rfind("fem", 0) == 0;
+        const bool fitted = model == "fitted springs";
+        auto       scene  = make_scene(prm, refinement, fitted);
+        if (n_frequencies > 0)
+        {
+          const std::string label = model + " x" + std::to_string(refinement);
+          if (fem)
+          {
+            SolverParameters parameters;
+            parameters.degree = model == "fem p2" ? 2 : 1;
+            print_frequencies(label,
+                              ElasticitySolver(problem_from_scene(*scene), parameters)
+                                .lowest_frequencies(n_frequencies));
+          }
+          else
+            print_frequencies(label, spring_frequencies(*scene->system, n_frequencies));
+        }
+        const auto                            &vertices = scene->mesh.get_vertices();
         std::vector<std::vector<mesh::Point3>> expected;
         for (const auto &field : reference)
           expected.push_back(evaluate(reference_scene->mesh, field, vertices));

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mpi.h>
 
@@ -374,5 +375,81 @@ namespace
       EXPECT_LT(fitted_nu, 0.12);
       EXPECT_GT(fitted_nu, 0.08);
     }
+  }
+} // namespace
+
+
+namespace
+{
+  using namespace lacerta;
+
+  /// prm/square_pull_accuracy.prm with its 4 x 4 x 1 box multiplied by @p factor, as
+  /// the study refines it.
+  std::unique_ptr<scene::Scene>
+  square_study_scene(const unsigned int factor)
+  {
+    return load_scene("square_pull_accuracy.prm",
+                      [&](dealii::ParameterHandler &prm)
+                      {
+                        const std::string n = std::to_string(4 * factor);
+                        set_entry(prm,
+                                  {"Mesh", "Box"},
+                                  "Repetitions",
+                                  n + ", " + n + ", " + std::to_string(factor));
+                      });
+  }
+
+
+  /// The square study's handles are the same blocks x in ±[2.5, 5] cm, |y| <= 2.5 cm at
+  /// every refinement: exactly the lattice vertices of those blocks are prescribed,
+  /// (r + 1)(2r + 1)(r + 1) per block, and nothing outside them.
+  TEST(FemAccuracy, SquareStudyHandlesAreResolvedByEveryRefinement)
+  {
+    for (const unsigned int r : {1u, 2u, 3u})
+    {
+      auto                           scene  = square_study_scene(r);
+      const physics::ParticleSystem &system = *scene->system;
+      const auto                    &rest   = system.rest_position();
+      unsigned int                   count  = 0;
+      for (unsigned int i = 0; i < system.n_particles(); ++i)
+        if (system.free[i] == 0)
+        {
+          ++count;
+          EXPECT_GE(std::abs(rest[3 * i]), 0.025 - 1e-12) << "refinement " << r;
+          EXPECT_LE(std::abs(rest[3 * i + 1]), 0.025 + 1e-12) << "refinement " << r;
+        }
+      EXPECT_EQ(count, 2 * (r + 1) * (2 * r + 1) * (r + 1)) << "refinement " << r;
+    }
+  }
+
+
+  /// Because every refinement solves the same problem, FEM converges on the square
+  /// slab: the static state at the end of the pull (handles 1 cm out, gravity) of P1
+  /// and P2 against P2 on the mesh refined three times.
+  TEST(FemAccuracy, FemConvergesOnTheSquareStudy)
+  {
+    fem::SolverParameters parameters;
+    auto                  reference_scene = square_study_scene(3);
+    fem::ElasticitySolver reference(fem::problem_from_scene(*reference_scene),
+                                    parameters);
+    const fem::NodalField reference_field = reference.solve_static(0.5);
+
+    std::map<unsigned int, std::vector<double>> errors;
+    for (const unsigned int degree : {1u, 2u})
+      for (const unsigned int r : {1u, 2u})
+      {
+        auto scene        = square_study_scene(r);
+        parameters.degree = degree;
+        fem::ElasticitySolver solver(fem::problem_from_scene(*scene), parameters);
+        const auto            expected = fem::evaluate(reference_scene->mesh,
+                                            reference_field,
+                                            scene->mesh.get_vertices());
+        errors[degree].push_back(
+          fem::nodal_error(solver.solve_static(0.5).vertex, expected).relative_l2());
+      }
+    for (const unsigned int degree : {1u, 2u})
+      EXPECT_LT(errors[degree][1], 0.6 * errors[degree][0])
+        << "P" << degree << ": " << errors[degree][0] << " -> " << errors[degree][1];
+    EXPECT_LT(errors[2][1], errors[1][1]);
   }
 } // namespace

@@ -59,8 +59,10 @@ namespace lacerta::fem
     unsigned int              reference_refinement;
     double                    reference_time_step;
     unsigned int              n_samples;
-    bool                      plot;
-    std::string               plot_script, output_directory;
-    bool                      test_mode;
+    /// How many lowest frequencies to print per model and refinement (0: none).
+    unsigned int n_frequencies = 0;
+    bool         plot;
+    std::string  plot_script, output_directory;
+    bool         test_mode;
   };
 } // namespace lacerta::fem
