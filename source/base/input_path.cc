@@ -32,4 +32,13 @@ namespace lacerta
       std::filesystem::path(input_directory()) / path;
     return std::filesystem::exists(beside_input) ? beside_input.string() : file_name;
   }
+
+
+  bool
+  ends_with(const std::string &file_name, const std::string &suffix)
+  {
+    return file_name.size() >= suffix.size()
+           && file_name.compare(file_name.size() - suffix.size(), suffix.size(), suffix)
+                == 0;
+  }
 } // namespace lacerta

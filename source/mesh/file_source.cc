@@ -12,14 +12,6 @@ namespace lacerta::mesh
 {
   namespace
   {
-    bool
-    ends_with(const std::string &text, const std::string &suffix)
-    {
-      return text.size() >= suffix.size()
-             && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
-    }
-
-
     /**
      * A mesh read from a file; the format follows the extension.
      */

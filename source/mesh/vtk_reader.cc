@@ -1,4 +1,5 @@
 #include <lacerta/base/exceptions.h>
+#include <lacerta/base/input_path.h>
 #include <lacerta/mesh/vtk_reader.h>
 
 #include <vtkCellData.h>
@@ -26,14 +27,6 @@ namespace lacerta::mesh
 {
   namespace
   {
-    bool
-    ends_with(const std::string &text, const std::string &suffix)
-    {
-      return text.size() >= suffix.size()
-             && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
-    }
-
-
     /**
      * Routes VTK's messages into a string while it lives. VTK reports some problems
      * (those of its XML parser, say) through the global output window rather than

@@ -84,20 +84,28 @@ namespace lacerta::scene
       void
       prescribe(const double t, const double *rest, double *x, double *v) const override
       {
-        const double h = 1e-7 * std::max(1.0, std::abs(t));
-        for (const unsigned int i : particles)
+        // One time level at a time: FunctionParser::set_time is not free, and this runs
+        // at every step for every particle of the handle.
+        const double h                  = 1e-7 * std::max(1.0, std::abs(t));
+        const auto   for_each_component = [&](const double time, const auto &use)
         {
-          const dealii::Point<3> p(rest[3 * i], rest[3 * i + 1], rest[3 * i + 2]);
-          for (unsigned int d = 0; d < 3; ++d)
+          displacement->set_time(time);
+          for (const unsigned int i : particles)
           {
-            displacement->set_time(t);
-            x[3 * i + d] = rest[3 * i + d] + displacement->value(p, d);
-            displacement->set_time(t + h);
-            const double ahead = displacement->value(p, d);
-            displacement->set_time(t - h);
-            v[3 * i + d] = (ahead - displacement->value(p, d)) / (2 * h);
+            const dealii::Point<3> p(rest[3 * i], rest[3 * i + 1], rest[3 * i + 2]);
+            for (unsigned int d = 0; d < 3; ++d)
+              use(3 * i + d, displacement->value(p, d));
           }
-        }
+        };
+        for_each_component(t,
+                           [&](const unsigned int c, const double u)
+                           { x[c] = rest[c] + u; });
+        // Central difference: v holds u(t + h) until u(t - h) is known.
+        for_each_component(t + h,
+                           [&](const unsigned int c, const double u) { v[c] = u; });
+        for_each_component(t - h,
+                           [&](const unsigned int c, const double u)
+                           { v[c] = (v[c] - u) / (2 * h); });
       }
 
     private:

@@ -22,4 +22,10 @@ namespace lacerta
    */
   std::string
   resolve_input_path(const std::string &file_name);
+
+  /**
+   * Whether @p file_name ends with @p suffix (an extension such as ".msh").
+   */
+  bool
+  ends_with(const std::string &file_name, const std::string &suffix);
 } // namespace lacerta
