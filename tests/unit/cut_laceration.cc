@@ -175,12 +175,12 @@ namespace
     }
   };
 
-  /// Uniform stretch by @p s along x about x = 0.5.
+  /// Uniform stretch by @p s along x about x = @p centre.
   std::function<Point(const Point &)>
-  stretch_x(const double s)
+  stretch_x(const double s, const double centre = 0.5)
   {
-    return [s](const Point &p) {
-      return Point{{0.5 + (1 + s) * (p[0] - 0.5), p[1], p[2]}};
+    return [s, centre](const Point &p) {
+      return Point{{centre + (1 + s) * (p[0] - centre), p[1], p[2]}};
     };
   }
 
@@ -258,6 +258,41 @@ TEST(CutLaceration, TearStopsWhereTheStressIsLow)
   EXPECT_NEAR(hi, 1.0, 1e-12);
   EXPECT_GT(lo, 0.3);
   EXPECT_LT(lo, 0.7);
+}
+
+
+TEST(CutLaceration, AStoppedTearContinuesFromItsTipWhenThePullGrows)
+{
+  // Weak only in the column of cells 0.375 < x < 0.5: the first tear takes its
+  // over-stretched springs; the rest of the slab is strong.
+  const auto limit = [](const dealii::Point<3> &p)
+  { return std::abs(p[0] - 0.4375) < 0.07 ? weak_near_one_edge(p) : 10.0; };
+  TearFixture                     f(stretch_x(0.4, 0.4375), limit, 3);
+  const cut::LacerationStatistics first = f.lacerator->check();
+  ASSERT_TRUE(first.torn);
+  ASSERT_FALSE(first.complete);
+  const double stop = f.torn_y_range().first;
+  // Nothing left to tear at this stretch.
+  EXPECT_FALSE(f.lacerator->check().torn);
+  // Pulled further (about the tear's plane, so that its tip stays where it was), the
+  // springs ahead of the tip pass their limit: the same laceration goes on from its
+  // tip (no second plane beside it) and reaches lower.
+  const auto more = stretch_x(1.5, 0.4375);
+  for (unsigned int i = 0; i < f.system->n_particles(); ++i)
+  {
+    const Point y = more(f.mesh.vertex(i));
+    for (unsigned int d = 0; d < 3; ++d)
+      f.system->position[3 * i + d] = y[d];
+  }
+  const cut::LacerationStatistics second = f.lacerator->check();
+  ASSERT_TRUE(second.torn);
+  EXPECT_TRUE(second.continued);
+  EXPECT_EQ(f.lacerator->n_tears(), 2u);
+  EXPECT_LT(f.torn_y_range().first, stop - 0.05);
+  f.expect_invariants("after the continuation");
+  // Past half their limit down to y = 0 at this stretch: the tear goes through.
+  EXPECT_TRUE(second.complete);
+  EXPECT_EQ(cut::count_components(f.mesh), 2u);
 }
 
 
