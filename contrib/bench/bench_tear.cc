@@ -15,13 +15,8 @@ namespace lacerta::bench
 {
   namespace
   {
-    using Clock = std::chrono::steady_clock;
-
-    double
-    seconds_since(const Clock::time_point start)
-    {
-      return std::chrono::duration<double>(Clock::now() - start).count();
-    }
+    using Clock   = std::chrono::steady_clock;
+    using Seconds = std::chrono::duration<double>;
 
     /**
      * The scene of square_tear.prm at n x n x 3 hexahedra (5 tetrahedra each), with
@@ -80,12 +75,12 @@ namespace lacerta::bench
                                high);
         const auto     t0 = Clock::now();
         const auto     c  = watcher.check();
-        check_seconds += seconds_since(t0);
+        check_seconds += Seconds(Clock::now() - t0).count();
         springs = c.surface_springs;
         // The tear: the check that finds the threshold reached and tears.
         const auto t1 = Clock::now();
         const auto s  = scene->lacerator->check();
-        tear_seconds += seconds_since(t1);
+        tear_seconds += Seconds(Clock::now() - t1).count();
         split    = s.cut_tets;
         created  = s.created_tets;
         complete = s.complete;
