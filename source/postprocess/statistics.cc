@@ -13,7 +13,8 @@ namespace lacerta::postprocess
   {
     /**
      * Writes statistics.csv: step, time, time step, sub-steps, energies, the work of
-     * the loads, and the wall time of the force evaluation and of the whole step.
+     * the loads, the wall time of the force evaluation and of the whole step, the cut
+     * columns (Table 1) and the laceration columns.
      */
     class Statistics : public Postprocessor
     {
@@ -39,7 +40,8 @@ namespace lacerta::postprocess
         file
           << "step,time,time_step,substeps,kinetic_energy,elastic_energy,"
              "body_force_energy,input_work,force_wall_s,step_wall_s,mesh_size,cut_tets,"
-             "created_tets,update_wall_ms\n";
+             "created_tets,update_wall_ms,over_limit,tears,torn_tets,tear_created_tets,"
+             "tear_wall_ms\n";
       }
 
       bool
@@ -51,10 +53,11 @@ namespace lacerta::postprocess
       void
       execute(const RunState &s) override
       {
-        char line[512];
+        char line[640];
         std::snprintf(line,
                       sizeof(line),
-                      "%u,%.9g,%.6g,%u,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%u,%u,%u,%.6g\n",
+                      "%u,%.9g,%.6g,%u,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%u,%u,%u,%.6g,%u,%u,"
+                      "%u,%u,%.6g\n",
                       s.step,
                       s.time,
                       s.time_step,
@@ -68,7 +71,12 @@ namespace lacerta::postprocess
                       s.mesh->n_tets(),
                       s.cut_tets,
                       s.created_tets,
-                      test_mode ? 0.0 : 1e3 * s.update_seconds);
+                      test_mode ? 0.0 : 1e3 * s.update_seconds,
+                      s.over_limit,
+                      s.tears,
+                      s.torn_tets,
+                      s.tear_created_tets,
+                      test_mode ? 0.0 : 1e3 * s.tear_seconds);
         file << line;
       }
 
@@ -86,5 +94,6 @@ namespace lacerta::postprocess
     "sub-steps, kinetic, elastic and body-force energy, work of "
     "the loads, wall time of force evaluation and of the step, and the "
     "paper's Table 1 columns: mesh size, tetrahedra cut and created, mesh "
-    "update wall time (ms).");
+    "update wall time (ms); and the laceration columns: surface springs past "
+    "their limit, tears, tetrahedra torn and created, tear wall time (ms).");
 } // namespace lacerta::postprocess

@@ -42,6 +42,13 @@ namespace lacerta::scene
                       "centroid of every tetrahedron for the spring stiffness "
                       "k_e = sum E V / |e|^2 (Section 3.2).");
     prm.declare_entry(
+      "Maximum elongation",
+      "0.3",
+      dealii::Patterns::Anything(),
+      "Largest strain (|x_i - x_j| - L) / L a spring bears before the tissue may tear "
+      "(Section 7), an expression of x, y, z evaluated at the spring's rest midpoint; "
+      "its values must lie in [0.001, 100]. Used only if 'Laceration/Enabled' is true.");
+    prm.declare_entry(
       "Poisson ratio",
       "0.25",
       dealii::Patterns::Double(0.0, 0.499),
@@ -84,6 +91,8 @@ namespace lacerta::scene
       parse_function("Material/Density", prm.get("Density"), 1, false, constants);
     youngs_function = parse_function(
       "Material/Youngs modulus", prm.get("Youngs modulus"), 1, false, constants);
+    elongation_function = parse_function(
+      "Material/Maximum elongation", prm.get("Maximum elongation"), 1, false, constants);
     poisson_ratio  = prm.get_double("Poisson ratio");
     fitted_springs = prm.get("Spring stiffness") == "fitted";
     mass_damping   = prm.get_double("Mass damping");

@@ -1,5 +1,6 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/cut/cutter.h>
+#include <lacerta/cut/lacerator.h>
 #include <lacerta/cut/tool.h>
 #include <lacerta/mesh/mesh_source.h>
 #include <lacerta/mt/multiresolution.h>
@@ -27,6 +28,7 @@ namespace lacerta::scene
     mt::Multiresolution::declare_parameters(prm);
     cut::Tool::declare_parameters(prm);
     cut::Cutter::declare_parameters(prm);
+    cut::Lacerator::declare_parameters(prm);
   }
 
 
@@ -58,8 +60,9 @@ namespace lacerta::scene
     system = std::make_unique<physics::ParticleSystem>(std::vector<double>());
     assemble(active_mesh(), 0.0);
     system->set_force_model(physics::ForceModel::create(prm), n_threads);
-    initial_volume = mesh.total_volume();
-    tool           = cut::Tool::create(prm);
+    initial_volume    = mesh.total_volume();
+    tool              = cut::Tool::create(prm);
+    cutter_parameters = cut::Cutter::parse_parameters(prm);
     if (tool)
     {
       if (multiresolution)
@@ -70,9 +73,41 @@ namespace lacerta::scene
                                              material.density(),
                                              material.youngs_modulus(),
                                              integral_of_density,
-                                             cut::Cutter::parse_parameters(prm),
+                                             cutter_parameters,
                                              tool->blade(0.0));
     }
+    if (cut::Lacerator::enabled(prm))
+    {
+      if (multiresolution)
+        throw_error("Laceration/Enabled: lacerations on the multiresolution model are "
+                    "not available yet; set 'Multiresolution/Enabled = false' or "
+                    "'Laceration/Enabled = false'.");
+      lacerator = std::make_unique<cut::Lacerator>(mesh,
+                                                   *system,
+                                                   material.density(),
+                                                   material.youngs_modulus(),
+                                                   material.maximum_elongation(),
+                                                   integral_of_density,
+                                                   cutter_parameters,
+                                                   cut::Lacerator::parse_parameters(prm));
+    }
+  }
+
+
+  void
+  Scene::restart_cutter()
+  {
+    if (!cutter)
+      return;
+    const cut::Blade blade = cutter->blade();
+    cutter.reset();
+    cutter = std::make_unique<cut::Cutter>(mesh,
+                                           *system,
+                                           material.density(),
+                                           material.youngs_modulus(),
+                                           integral_of_density,
+                                           cutter_parameters,
+                                           blade);
   }
 
 

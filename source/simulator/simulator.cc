@@ -2,6 +2,7 @@
 #include <lacerta/base/input_path.h>
 #include <lacerta/cut/cutter.h>
 #include <lacerta/cut/invariants.h>
+#include <lacerta/cut/lacerator.h>
 #include <lacerta/cut/tool.h>
 #include <lacerta/fem/study.h>
 #include <lacerta/mt/multiresolution.h>
@@ -344,6 +345,8 @@ namespace lacerta
     unsigned int          cutting_steps      = 0;
     unsigned long long    n_integrator_steps = 0;
     double                sum_cut = 0, sum_created = 0, sum_update = 0, sum_relax = 0;
+    unsigned int          n_tears = 0, n_torn = 0, n_tear_created = 0;
+    double                sum_tear = 0;
     postprocess::RunState state;
     state.mesh     = &scene->active_mesh();
     state.system   = &system;
@@ -395,6 +398,9 @@ namespace lacerta
       const auto   step_start = Clock::now();
       state.cut_tets = state.created_tets = 0;
       state.update_seconds                = 0;
+      state.over_limit = state.tears = state.torn_tets = state.tear_created_tets = 0;
+      state.tear_seconds                                                         = 0;
+      bool cut_changed                                                           = false;
       if (scene->cutter)
       {
         dealii::TimerOutput::Scope   scope(timer, "cut");
@@ -403,10 +409,50 @@ namespace lacerta
         state.cut_tets       = cut.cut_tets;
         state.created_tets   = cut.created_tets;
         state.update_seconds = cut.update_seconds;
+        cut_changed          = cut.changed;
         if (cut.changed)
         {
           // New particles and springs: the integrator's scratch space, the stability
           // limit and the energy baseline of the blow-up monitor start afresh.
+          check(step);
+          integrator->initialize(system);
+          substeps       = choose_substeps();
+          state.substeps = substeps;
+          monitor        = physics::BlowUpMonitor(system, energy_tolerance);
+        }
+      }
+      if (scene->lacerator)
+      {
+        dealii::TimerOutput::Scope scope(timer, "laceration");
+        if (cut_changed)
+          scene->lacerator->mesh_changed();
+        const cut::LacerationStatistics tear = scene->lacerator->check();
+        state.over_limit                     = tear.over_limit;
+        if (tear.changed)
+        {
+          state.tears             = 1;
+          state.torn_tets         = tear.cut_tets;
+          state.tear_created_tets = tear.created_tets;
+          state.tear_seconds      = tear.update_seconds;
+          ++n_tears;
+          n_torn += tear.cut_tets;
+          n_tear_created += tear.created_tets;
+          sum_tear += tear.update_seconds;
+          std::cout << "Laceration at t = " << time + dt
+                    << " s: " << (tear.continued ? "continued" : "started")
+                    << " at the spring " << tear.seed_a << "-" << tear.seed_b << " ("
+                    << tear.seed_ratio << " times its maximum elongation, "
+                    << tear.over_limit << " surface springs past their limit); "
+                    << tear.advances << " advances, "
+                    << (tear.complete ? "through" : "stopped inside") << "; "
+                    << tear.cut_tets << " tetrahedra split into " << tear.created_tets
+                    << "; mesh components " << cut::count_components(scene->mesh);
+          if (!test_mode)
+            std::cout << "; " << 1e3 * tear.update_seconds << " ms";
+          std::cout << "\n";
+          // The scalpel's search structures must see the torn faces; then as after a
+          // cut: new scratch space, stability limit and energy baseline.
+          scene->restart_cutter();
           check(step);
           integrator->initialize(system);
           substeps       = choose_substeps();
@@ -490,6 +536,15 @@ namespace lacerta
         std::cout << ", UpdT " << 1e3 * sum_update / cutting_steps << " ms, RxT "
                   << 1e3 * sum_relax / cutting_steps << " ms";
       std::cout << "; mesh components " << cut::count_components(scene->mesh) << "\n";
+    }
+    if (scene->lacerator)
+    {
+      std::cout << "Laceration summary: " << n_tears << " tears, " << n_torn
+                << " tetrahedra split into " << n_tear_created;
+      if (!test_mode && n_tears > 0)
+        std::cout << ", " << 1e3 * sum_tear / n_tears << " ms per tear";
+      std::cout << "; mesh " << scene->mesh.n_tets() << " tetrahedra, components "
+                << cut::count_components(scene->mesh) << "\n";
     }
     if (!test_mode)
     {

@@ -48,6 +48,11 @@ namespace lacerta::postprocess
     /// wall time of the mesh update (s); all zero in a scene without a tool.
     unsigned int cut_tets = 0, created_tets = 0;
     double       update_seconds = 0;
+    /// Lacerations of this step (Section 7): surface springs past their limit, tears,
+    /// tetrahedra the tear split and created, and its wall time (s); all zero in a
+    /// scene without lacerations.
+    unsigned int over_limit = 0, tears = 0, torn_tets = 0, tear_created_tets = 0;
+    double       tear_seconds = 0;
   };
 
 

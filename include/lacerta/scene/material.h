@@ -40,6 +40,17 @@ namespace lacerta::scene
       return *youngs_function;
     }
 
+    /**
+     * Maximum elongation ε_max(x) of a spring, as a strain (|x_i - x_j| - L) / L,
+     * evaluated at the spring's rest midpoint (Section 7; read only by scenes that
+     * enable `Laceration`).
+     */
+    const dealii::Function<3> &
+    maximum_elongation() const
+    {
+      return *elongation_function;
+    }
+
     /// Poisson ratio (used by the FEM reference; springs behave as ν = 1/4).
     double poisson_ratio = 0.25;
     /// Whether spring stiffnesses are fitted to linear elasticity (Lloyd et al. 2007)
@@ -53,5 +64,6 @@ namespace lacerta::scene
   private:
     std::unique_ptr<dealii::FunctionParser<3>> density_function;
     std::unique_ptr<dealii::FunctionParser<3>> youngs_function;
+    std::unique_ptr<dealii::FunctionParser<3>> elongation_function;
   };
 } // namespace lacerta::scene

@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include <lacerta/cut/cutter.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/scene/body_force.h>
 #include <lacerta/scene/constraint.h>
@@ -25,7 +26,7 @@ namespace lacerta::mt
 namespace lacerta::cut
 {
   class Tool;
-  class Cutter;
+  class Lacerator;
 } // namespace lacerta::cut
 
 namespace lacerta::scene
@@ -95,6 +96,17 @@ namespace lacerta::scene
     std::unique_ptr<cut::Tool>   tool;
     std::unique_ptr<cut::Cutter> cutter;
 
+    /// The lacerator, only if `Laceration/Enabled` is true.
+    std::unique_ptr<cut::Lacerator> lacerator;
+
+    /**
+     * After a tear changed the mesh under the scalpel: the cutter starts afresh at its
+     * blade (a stroke in progress restarts there), so that its search structures see
+     * the torn faces. Nothing without a cutter.
+     */
+    void
+    restart_cutter();
+
   private:
     /**
      * Sets the particle system up on @p active (the mesh or a level of detail) at time
@@ -104,7 +116,9 @@ namespace lacerta::scene
     void
     assemble(const mesh::TetMesh &active, double t);
 
-    bool         has_varying_loads = false;
-    unsigned int n_threads         = 1;
+    /// The parameters of `subsection Cut`, for restart_cutter().
+    cut::Cutter::Parameters cutter_parameters;
+    bool                    has_varying_loads = false;
+    unsigned int            n_threads         = 1;
   };
 } // namespace lacerta::scene

@@ -1,0 +1,454 @@
+#include <lacerta/base/exceptions.h>
+#include <lacerta/cut/lacerator.h>
+#include <lacerta/physics/particle_system.h>
+
+#include <deal.II/base/function.h>
+#include <deal.II/base/point.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace lacerta::cut
+{
+  namespace
+  {
+    using Clock = std::chrono::steady_clock;
+
+    constexpr double min_elongation = 1e-3, max_elongation = 100;
+
+    constexpr unsigned int no_laceration = static_cast<unsigned int>(-1);
+
+    Point
+    midpoint(const Point &a, const Point &b)
+    {
+      return scale(0.5, add(a, b));
+    }
+  } // namespace
+
+
+  void
+  Lacerator::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection("Laceration");
+    prm.declare_entry(
+      "Enabled",
+      "false",
+      dealii::Patterns::Bool(),
+      "Whether over-stretched tissue tears (Section 7): surface springs beyond "
+      "'Material/Maximum elongation' are collected in a heap and a laceration is "
+      "propagated from the most stretched one (doc/lacerations.md). Without it no "
+      "laceration structure is built.");
+    prm.declare_entry(
+      "Threshold h",
+      "3",
+      dealii::Patterns::Integer(1, 1000),
+      "The paper's h: no tear starts until at least this many surface springs "
+      "exceed their maximum elongation.");
+    prm.declare_entry(
+      "Propagation fraction",
+      "0.5",
+      dealii::Patterns::Double(0.05, 1.0),
+      "A laceration advances while the most stretched spring it is about to cross "
+      "is elongated beyond this fraction of its maximum; it stops where the stress "
+      "is lower.");
+    prm.leave_subsection();
+  }
+
+
+  bool
+  Lacerator::enabled(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection("Laceration");
+    const bool on = prm.get_bool("Enabled");
+    prm.leave_subsection();
+    return on;
+  }
+
+
+  Lacerator::Parameters
+  Lacerator::parse_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection("Laceration");
+    Parameters p;
+    p.threshold            = prm.get_integer("Threshold h");
+    p.propagation_fraction = prm.get_double("Propagation fraction");
+    prm.leave_subsection();
+    return p;
+  }
+
+
+  Lacerator::Lacerator(mesh::TetMesh                     &mesh_in,
+                       physics::ParticleSystem           &system_in,
+                       const dealii::Function<3, double> &density_in,
+                       const dealii::Function<3, double> &youngs_modulus_in,
+                       const dealii::Function<3, double> &maximum_elongation_in,
+                       double                            &integral,
+                       const Cutter::Parameters          &cut_parameters_in,
+                       const Parameters                  &parameters_in)
+      : mesh(mesh_in)
+      , system(system_in)
+      , density(density_in)
+      , youngs_modulus(youngs_modulus_in)
+      , maximum_elongation(maximum_elongation_in)
+      , integral_of_density(integral)
+      , cut_parameters(cut_parameters_in)
+      , parameters(parameters_in)
+  {
+    // A bad limit anywhere on the object is reported now, not at the first tear.
+    for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
+      limit_at(mesh.vertex(v));
+    collect_surface_springs();
+    // The element size of the tissue as built: the mean surface spring at rest.
+    for (const SurfaceSpring &spring : surface)
+      typical_edge += spring.rest_length / surface.size();
+  }
+
+
+  Lacerator::~Lacerator() = default;
+
+
+  double
+  Lacerator::limit_at(const Point &x) const
+  {
+    const double limit = maximum_elongation.value(dealii::Point<3>(x[0], x[1], x[2]));
+    if (!(limit >= min_elongation && limit <= max_elongation))
+      throw_error("Material/Maximum elongation: the value ",
+                  limit,
+                  " at (",
+                  x[0],
+                  ", ",
+                  x[1],
+                  ", ",
+                  x[2],
+                  ") is outside [",
+                  min_elongation,
+                  ", ",
+                  max_elongation,
+                  "] (a strain).");
+    return limit;
+  }
+
+
+  Point
+  Lacerator::position(const unsigned int v) const
+  {
+    const double *x = &system.position[3 * v];
+    return {{x[0], x[1], x[2]}};
+  }
+
+
+  void
+  Lacerator::collect_surface_springs()
+  {
+    std::vector<std::pair<unsigned int, unsigned int>> edges;
+    edges.reserve(3 * mesh.get_boundary_faces().size());
+    for (const auto &f : mesh.get_boundary_faces())
+    {
+      const auto &fv = mesh::TetMesh::face_vertices[f.face];
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        const unsigned int a = mesh.tet(f.tet)[fv[k]],
+                           b = mesh.tet(f.tet)[fv[(k + 1) % 3]];
+        edges.emplace_back(std::min(a, b), std::max(a, b));
+      }
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    surface.clear();
+    surface.reserve(edges.size());
+    for (const auto &[a, b] : edges)
+    {
+      const Point &xa = mesh.vertex(a), &xb = mesh.vertex(b);
+      surface.push_back({a, b, norm(sub(xb, xa)), limit_at(midpoint(xa, xb))});
+    }
+    surface_valid = true;
+  }
+
+
+  double
+  Lacerator::ratio(const unsigned int a, const unsigned int b) const
+  {
+    const Point &ra = mesh.vertex(a), &rb = mesh.vertex(b);
+    const double rest = norm(sub(rb, ra));
+    const double now  = norm(sub(position(b), position(a)));
+    return (now - rest) / rest / limit_at(midpoint(ra, rb));
+  }
+
+
+  bool
+  Lacerator::in_wake(const Point &x) const
+  {
+    for (const Laceration &l : lacerations)
+    {
+      const Point  r      = sub(x, l.origin);
+      const double across = dot(l.across, r);
+      if (std::abs(dot(l.normal, r)) <= l.edge
+          && (l.complete || dot(l.advance, r) <= l.stop) && across >= l.across_lo - l.edge
+          && across <= l.across_hi + l.edge)
+        return true;
+    }
+    return false;
+  }
+
+
+  void
+  Lacerator::mesh_changed()
+  {
+    surface_valid = false;
+  }
+
+
+  void
+  Lacerator::find_crossings(const Laceration &l)
+  {
+    crossings.clear();
+    const physics::SpringSet &springs = system.springs;
+    for (std::size_t s = 0; s < springs.size(); ++s)
+    {
+      const Point  xa = position(springs.a[s]), xb = position(springs.b[s]);
+      const double da = dot(l.normal, sub(xa, l.origin));
+      const double db = dot(l.normal, sub(xb, l.origin));
+      if ((da > 0) == (db > 0) || da == db)
+        continue;
+      const Point  p      = lerp(xa, xb, da / (da - db));
+      const double across = dot(l.across, sub(p, l.origin));
+      if (across < l.across_lo - l.edge || across > l.across_hi + l.edge)
+        continue;
+      crossings.push_back(
+        {p, dot(l.advance, sub(p, l.origin)), springs.a[s], springs.b[s]});
+    }
+  }
+
+
+  Blade
+  Lacerator::blade_at(const Laceration &l, const double along) const
+  {
+    const Point centre = add(l.origin, scale(along, l.advance));
+    return {add(centre, scale(l.across_lo - l.edge, l.across)),
+            add(centre, scale(l.across_hi + l.edge, l.across))};
+  }
+
+
+  void
+  Lacerator::advance(const unsigned int    index,
+                     const double          from,
+                     const double          forced,
+                     LacerationStatistics &s)
+  {
+    Laceration &l = lacerations[index];
+    if (!l.cutter)
+      l.cutter = std::make_shared<Cutter>(mesh,
+                                          system,
+                                          density,
+                                          youngs_modulus,
+                                          integral_of_density,
+                                          cut_parameters,
+                                          blade_at(l, from));
+    double       u     = from;
+    const double exit  = l.end + l.edge;
+    const auto   apply = [&](const double next)
+    {
+      const unsigned int      before = system.n_particles();
+      const CutStepStatistics c      = l.cutter->move_blade(blade_at(l, next));
+      sheet.resize(system.n_particles(), no_laceration);
+      for (unsigned int v = before; v < system.n_particles(); ++v)
+        sheet[v] = index;
+      s.cut_tets += c.cut_tets;
+      s.created_tets += c.created_tets;
+      s.new_particles += c.new_particles;
+      s.changed |= c.changed;
+      ++s.advances;
+      u = next;
+    };
+    while (u < exit)
+    {
+      const double next = std::min(u + l.edge, exit);
+      if (next > forced)
+      {
+        double most  = -std::numeric_limits<double>::infinity();
+        bool   ahead = false;
+        for (const Crossing &c : crossings)
+          if (c.along > u && c.along <= next)
+          {
+            ahead = true;
+            most  = std::max(most, ratio(c.a, c.b));
+          }
+        // Low stress ahead: the tear stops (a gap in the section is crossed).
+        if (ahead && most < parameters.propagation_fraction)
+          break;
+      }
+      apply(next);
+    }
+    l.stop     = u;
+    l.complete = u >= exit;
+    if (l.complete)
+      l.cutter.reset();
+  }
+
+
+  void
+  Lacerator::start(const SurfaceSpring &seed, LacerationStatistics &s)
+  {
+    const Point xa = position(seed.a), xb = position(seed.b);
+    const Point m = midpoint(xa, xb);
+    const Point e = normalized(sub(xb, xa));
+    Laceration  l;
+    l.origin = m;
+    // The band of one advance: an element's size (a seed made short by earlier cuts
+    // must not make the tear crawl).
+    l.edge = std::max(norm(sub(xb, xa)), typical_edge);
+    // The plane's normal: the mean direction of the over-stretched springs around the
+    // seed, weighted by how far past their limit they are (one spring's direction is
+    // the mesh's, the mean is closer to the principal stress).
+    Point normal{{0, 0, 0}};
+    for (const auto &[r, i] : heap)
+    {
+      const Point pa = position(surface[i].a), pb = position(surface[i].b);
+      if (norm(sub(midpoint(pa, pb), m)) > 2 * l.edge)
+        continue;
+      Point d = normalized(sub(pb, pa));
+      if (dot(d, e) < 0)
+        d = scale(-1, d);
+      normal = add(normal, scale(r, d));
+    }
+    l.normal = norm(normal) > 0 ? normalized(normal) : e;
+    // The section of the body by the plane, sampled by the springs crossing it: its
+    // long axis is the way the tear runs, its short axis (the thickness) the blade's.
+    l.across    = l.normal; // unused by the unrestricted search below
+    l.across_lo = -std::numeric_limits<double>::infinity();
+    l.across_hi = std::numeric_limits<double>::infinity();
+    find_crossings(l);
+    const Point helper =
+      std::abs(l.normal[0]) < 0.9 ? Point{{1, 0, 0}} : Point{{0, 1, 0}};
+    const Point e1 = normalized(cross(l.normal, helper));
+    const Point e2 = cross(l.normal, e1);
+    Point       centroid{{0, 0, 0}};
+    for (const Crossing &c : crossings)
+      centroid = add(centroid, c.at);
+    if (!crossings.empty())
+      centroid = scale(1.0 / crossings.size(), centroid);
+    double c11 = 0, c12 = 0, c22 = 0;
+    for (const Crossing &c : crossings)
+    {
+      const double p = dot(e1, sub(c.at, centroid)), q = dot(e2, sub(c.at, centroid));
+      c11 += p * p;
+      c12 += p * q;
+      c22 += q * q;
+    }
+    const double angle = 0.5 * std::atan2(2 * c12, c11 - c22);
+    l.advance          = add(scale(std::cos(angle), e1), scale(std::sin(angle), e2));
+    l.across           = cross(l.normal, l.advance);
+    double lo = 0, hi = 0;
+    l.across_lo = l.across_hi = 0;
+    for (const Crossing &c : crossings)
+    {
+      const Point r = sub(c.at, m);
+      lo            = std::min(lo, dot(l.advance, r));
+      hi            = std::max(hi, dot(l.advance, r));
+      l.across_lo   = std::min(l.across_lo, dot(l.across, r));
+      l.across_hi   = std::max(l.across_hi, dot(l.across, r));
+    }
+    // The tear enters from the end of the section nearest to the seed.
+    if (-lo > hi)
+    {
+      l.advance = scale(-1, l.advance);
+      l.across  = scale(-1, l.across);
+      std::swap(lo, hi);
+      lo = -lo;
+      hi = -hi;
+      std::swap(l.across_lo, l.across_hi);
+      l.across_lo = -l.across_lo;
+      l.across_hi = -l.across_hi;
+    }
+    l.end = hi;
+    find_crossings(l);
+    lacerations.push_back(l);
+    // Up to one band past the seed the tear runs whatever the stress: the seed spring
+    // must break and the tear must reach the surface.
+    advance(lacerations.size() - 1, lo - l.edge, l.edge, s);
+  }
+
+
+  LacerationStatistics
+  Lacerator::check()
+  {
+    LacerationStatistics s;
+    if (!surface_valid)
+      collect_surface_springs();
+    s.surface_springs = static_cast<unsigned int>(surface.size());
+    heap.clear();
+    const auto less = [](const std::pair<double, unsigned int> &x,
+                         const std::pair<double, unsigned int> &y)
+    { return x.first < y.first; };
+    for (unsigned int i = 0; i < surface.size(); ++i)
+    {
+      const SurfaceSpring &spring = surface[i];
+      const double         now    = norm(sub(position(spring.b), position(spring.a)));
+      const double r = (now - spring.rest_length) / spring.rest_length / spring.limit;
+      // Springs of a laceration's own faces, or next to its torn part, were split by
+      // it; they relax as it opens and do not start another one. Tissue held by an
+      // instrument does not tear under its jaws, and the short springs of the splits at a
+      // crack tip are no tissue of their own: neither is a seed.
+      const bool on_sheet = spring.a < sheet.size() && spring.b < sheet.size()
+                            && sheet[spring.a] != no_laceration
+                            && sheet[spring.b] != no_laceration;
+      if (r >= 1 && !on_sheet
+          && !in_wake(midpoint(position(spring.a), position(spring.b)))
+          && system.free[spring.a] > 0 && system.free[spring.b] > 0
+          && spring.rest_length >= 0.25 * typical_edge)
+      {
+        heap.emplace_back(r, i);
+        std::push_heap(heap.begin(), heap.end(), less);
+      }
+    }
+    s.over_limit = static_cast<unsigned int>(heap.size());
+    if (heap.empty() || heap.size() < parameters.threshold)
+      return s;
+
+    const auto           t0   = Clock::now();
+    const SurfaceSpring &seed = surface[heap.front().second];
+    s.torn                    = true;
+    s.seed_a                  = seed.a;
+    s.seed_b                  = seed.b;
+    s.seed_ratio              = heap.front().first;
+    const Point x             = midpoint(position(seed.a), position(seed.b));
+    for (unsigned int i = 0; i < lacerations.size(); ++i)
+    {
+      // At the tip of a laceration that stopped inside (a particle it created, or
+      // just ahead of its front): it goes on in its own plane, from where it stopped
+      // (the stress concentrates at a crack tip).
+      Laceration  &l       = lacerations[i];
+      const Point  r       = sub(x, l.origin);
+      const double u       = dot(l.advance, r);
+      const bool   created = (seed.a < sheet.size() && sheet[seed.a] == i)
+                           || (seed.b < sheet.size() && sheet[seed.b] == i);
+      if (l.cutter
+          && (created
+              || (std::abs(dot(l.normal, r)) <= l.edge && u > l.stop - l.edge
+                  && u <= l.stop + 2 * l.edge)))
+      {
+        s.continued = true;
+        find_crossings(l);
+        advance(i, l.stop, l.stop, s);
+        s.complete = lacerations[i].complete;
+        break;
+      }
+    }
+    if (!s.continued)
+    {
+      start(seed, s);
+      s.complete = lacerations.back().complete;
+    }
+    if (s.changed)
+    {
+      surface_valid = false;
+      ++tears;
+    }
+    else
+      s.torn = false;
+    s.update_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    return s;
+  }
+} // namespace lacerta::cut
