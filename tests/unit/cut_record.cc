@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cut_split_support.h"
 #include "physics_test_support.h"
 #include <map>
 #include <set>
@@ -49,11 +50,10 @@ namespace lacerta
         m, *system, sigma, youngs, integral, cut::Cutter::Parameters(), path[0]);
       std::vector<cut::CutRecord> records;
       cutter.set_recorder(&records);
-      for (std::size_t k = 0; k + 1 < path.size(); ++k)
-        for (unsigned int s = 1; s <= steps; ++s)
-          cutter.move_blade(
-            {cut::lerp(path[k].tail, path[k + 1].tail, double(s) / steps),
-             cut::lerp(path[k].head, path[k + 1].head, double(s) / steps)});
+      cut::test_support::stroke(cutter,
+                                path,
+                                steps,
+                                [](std::size_t, unsigned int) { return true; });
       ASSERT_FALSE(records.empty());
 
       std::set<Tet> current;
