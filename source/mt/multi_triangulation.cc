@@ -38,9 +38,10 @@ namespace lacerta::mt
         || error.size() != n || ball.size() != n || creator.size() != tets.size()
         || destroyer.size() != tets.size() || vertex_node.size() != vertices.size()
         || fine_begin.front() != 0
-        || fine_begin.back() != (replaced.empty() ? tets.size() : fine_begin.back())
-        || fine_begin.back() > tets.size() || coarse_begin.front() != 0
-        || coarse_begin.back() != coarse_list.size()
+        // Tets beyond the decimation's ranges are children a cut appended.
+        || (replaced.empty() ? fine_begin.back() != tets.size()
+                             : fine_begin.back() > tets.size())
+        || coarse_begin.front() != 0 || coarse_begin.back() != coarse_list.size()
         || (!cut_fine.empty() && (cut_fine.size() != n || cut_coarse.size() != n))
         || (!replaced.empty() && replaced.size() != tets.size())
         || cut_origin.size() > vertices.size())
