@@ -316,6 +316,28 @@ namespace lacerta
   }
 
 
+  TEST(MtCut, TheLevelOfDetailThatFollowedTheCutUpdatesLikeAFreshOne)
+  {
+    // The cut LOD's frontier bookkeeping stays right: updated incrementally from it,
+    // every query selects the same tets as an extraction from scratch.
+    LodCut c(*make_query("focus", {{"Radius", "0.2"}, {"Cell size growth", "0.5"}}),
+             {vertical(-0.2, 0.43), vertical(1.2, 0.47)},
+             12);
+    for (const double h : {0.0, 0.6, 0.2, 1000.0, 0.0})
+    {
+      const auto query = uniform(h);
+      c.lod.extract(*query);
+      mt::Lod fresh(c.mt);
+      fresh.extract(*query);
+      std::vector<std::uint32_t> a = c.lod.active_tets(), b = fresh.active_tets();
+      std::sort(a.begin(), a.end());
+      std::sort(b.begin(), b.end());
+      EXPECT_EQ(a, b) << "cell size " << h;
+      expect_front_of_dag(c.mt, c.lod);
+    }
+  }
+
+
   TEST(MtCut, VerticesACutCreatedAreLocatedInThePreviousLevel)
   {
     LodCut            c(*uniform(0.5), {vertical(-0.2, 0.43), vertical(1.2, 0.47)}, 12);
