@@ -11,6 +11,7 @@
 #include <deal.II/grid/grid_generator.h>
 #include <deal.II/grid/tria.h>
 
+#include "bench_support.h"
 #include "benchmark_registry.h"
 #include <chrono>
 #include <cstdio>
@@ -43,17 +44,10 @@ namespace lacerta::bench
         dealii::Point<3>(0.05, 0.05, 0.02));
       mesh::TetMesh mesh = mesh::tet_mesh_from_triangulation(tria, "benchmark slab");
       mesh.sort_spatially();
-      std::vector<double> rest(3 * mesh.n_vertices());
-      for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
-        for (unsigned int d = 0; d < 3; ++d)
-          rest[3 * v + d] = mesh.vertex(v)[d];
-      physics::ParticleSystem                      system(rest);
       const dealii::Functions::ConstantFunction<3> density(1000), youngs(5e4);
-      system.mass                = physics::compute_masses(mesh, density);
-      system.springs             = physics::compute_springs(mesh, youngs);
-      system.enforce_constraints = [](double, double *, double *) {};
-      system.set_force_model(physics::ForceModelRegistry::create("linear springs"), 1);
-      double integral = physics::integrate_over_mesh(mesh, density);
+      const auto               particles = make_particle_system(mesh, density, youngs);
+      physics::ParticleSystem &system    = *particles;
+      double                   integral  = physics::integrate_over_mesh(mesh, density);
       std::unique_ptr<physics::Integrator> rk4 =
         physics::IntegratorRegistry::create("rk4");
       rk4->initialize(system);

@@ -673,6 +673,11 @@ namespace lacerta::cut
       return;
     }
 
+    // The record of this sweep for the Multi-Triangulation (set_recorder()).
+    CutRecord *record = recorder ? &recorder->emplace_back() : nullptr;
+    if (record)
+      record->cuts = cuts;
+
     // Mass and stiffness contributions of the tetrahedra that go.
     std::map<unsigned int, double>                              mass_delta;
     std::vector<std::pair<std::array<unsigned int, 2>, double>> stiffness_delta;
@@ -696,6 +701,7 @@ namespace lacerta::cut
     std::vector<mesh::Tet>                   children;
     std::vector<std::array<unsigned int, 4>> face_ids;
     std::set<std::array<unsigned int, 3>>    cut_faces;
+    std::vector<std::array<unsigned int, 2>> child_origin; // (split, child), recording
     const auto new_particle = [&](const Point &rest, const unsigned int parent)
     {
       const mesh::Tet &tet = mesh.tet(parent);
@@ -749,6 +755,17 @@ namespace lacerta::cut
               on_surface_list.push_back(t[j]);
             }
             ids.emplace(key, t[j]);
+            if (record)
+            {
+              CutRecord::NewPoint point{t[j], n.kind, key.side, {}, p};
+              for (unsigned int m = 0; m < 4; ++m)
+                point.ids[m] = n.kind == NodeKind::interior_point
+                                 ? static_cast<unsigned int>(c.vertex_ids[m])
+                                 : (m < 3 ? static_cast<unsigned int>(key.ids[m]) : 0);
+              std::sort(point.ids.begin(),
+                        point.ids.begin() + (n.kind == NodeKind::interior_point ? 4 : 0));
+              record->new_points.push_back(point);
+            }
           }
         }
         std::array<unsigned int, 4> fid{{0, 0, 0, 0}};
@@ -774,6 +791,8 @@ namespace lacerta::cut
         }
         children.push_back(t);
         face_ids.push_back(fid);
+        if (record)
+          child_origin.push_back({{static_cast<unsigned int>(k), i}});
       }
     }
     // Vertices on the cut: one copy per group of their children connected through
@@ -821,7 +840,18 @@ namespace lacerta::cut
           on_surface_list.push_back(copy);
           ++statistics.new_particles;
           it = copy_of_root.emplace(root, copy).first;
+          if (record)
+            record->new_points.push_back(
+              {copy, NodeKind::vertex, 0, {{v, 0, 0, 0}}, mesh.vertex(v)});
         }
+        if (record)
+          for (unsigned int m = 0; m < 4; ++m)
+            if (children[list[i]][m] == v)
+              record->vertex_choices.push_back(
+                {child_origin[list[i]][0],
+                 static_cast<std::uint8_t>(child_origin[list[i]][1]),
+                 static_cast<std::uint8_t>(m),
+                 it->second});
         for (auto &node : children[list[i]])
           if (node == v)
             node = it->second;

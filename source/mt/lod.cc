@@ -20,7 +20,18 @@ namespace lacerta::mt
       , check_at(mt.n_nodes(), 0)
   {
     applied[0] = 1;
-    for (std::uint32_t t = mt.fine_begin[0]; t < mt.fine_begin[1]; ++t)
+    mt.for_each_fine(0, [this](const std::uint32_t t) { activate(t); });
+  }
+
+
+  void
+  Lod::follow_cut(const std::uint32_t parent, const std::vector<std::uint32_t> &children)
+  {
+    position.resize(mt->n_tets(), mesh::invalid_index);
+    if (!is_active(parent))
+      return;
+    deactivate(parent);
+    for (const std::uint32_t t : children)
       activate(t);
   }
 
@@ -123,20 +134,15 @@ namespace lacerta::mt
     applied[j]       = apply;
     changed[j] ^= 1;
     changed_list.push_back(j);
-    const auto fine_begin = mt->fine_begin[j], fine_end = mt->fine_begin[j + 1];
-    const auto coarse_begin = mt->coarse_list.begin() + mt->coarse_begin[j];
-    const auto coarse_end   = mt->coarse_list.begin() + mt->coarse_begin[j + 1];
     if (apply)
     {
-      std::for_each(coarse_begin, coarse_end, [this](auto t) { deactivate(t); });
-      for (std::uint32_t t = fine_begin; t < fine_end; ++t)
-        activate(t);
+      mt->for_each_coarse(j, [this](const std::uint32_t t) { deactivate(t); });
+      mt->for_each_fine(j, [this](const std::uint32_t t) { activate(t); });
     }
     else
     {
-      for (std::uint32_t t = fine_begin; t < fine_end; ++t)
-        deactivate(t);
-      std::for_each(coarse_begin, coarse_end, [this](auto t) { activate(t); });
+      mt->for_each_fine(j, [this](const std::uint32_t t) { deactivate(t); });
+      mt->for_each_coarse(j, [this](const std::uint32_t t) { activate(t); });
     }
   }
 
@@ -198,12 +204,14 @@ namespace lacerta::mt
         continue;
       toggle(j);
       ++n_last_undone;
-      for (std::uint32_t k = mt->coarse_begin[j]; k < mt->coarse_begin[j + 1]; ++k)
-      {
-        const std::uint32_t p = mt->creator[mt->coarse_list[k]];
-        if (p != 0 && active_fine[p] == mt->n_fine(p) && !needs(p, query))
-          to_undo.push_back(p);
-      }
+      mt->for_each_coarse(j,
+                          [&](const std::uint32_t t)
+                          {
+                            const std::uint32_t p = mt->creator[t];
+                            if (p != 0 && active_fine[p] == mt->n_fine(p)
+                                && !needs(p, query))
+                              to_undo.push_back(p);
+                          });
     }
     while (!to_apply.empty())
     {
@@ -213,13 +221,14 @@ namespace lacerta::mt
         continue;
       toggle(j);
       ++n_last_applied;
-      for (std::uint32_t t = mt->fine_begin[j]; t < mt->fine_begin[j + 1]; ++t)
-      {
-        const std::uint32_t c = mt->destroyer[t];
-        if (c != mesh::invalid_index && active_coarse[c] == mt->n_coarse(c)
-            && needs(c, query))
-          to_apply.push_back(c);
-      }
+      mt->for_each_fine(j,
+                        [&](const std::uint32_t t)
+                        {
+                          const std::uint32_t c = mt->destroyer[t];
+                          if (c != mesh::invalid_index
+                              && active_coarse[c] == mt->n_coarse(c) && needs(c, query))
+                            to_apply.push_back(c);
+                        });
     }
     // Every frontier node is now stable (applicable ones not needed, undoable ones
     // needed); those tested or new in this call wait for their slack. Stale entries
@@ -282,26 +291,46 @@ namespace lacerta::mt
   Lod::locate_in_previous(const std::uint32_t v) const
   {
     const mesh::Point3 &p = mt->vertices[v];
-    std::uint32_t       j = mt->vertex_node[v];
+    // The tet of a fragment that contains p, or the one p is least outside of.
+    std::uint32_t         best = mesh::invalid_index;
+    std::array<double, 4> best_coordinates{};
+    double                best_minimum = -1e300;
+    const auto            consider     = [&](const std::uint32_t t)
+    {
+      const auto   b = mt->barycentric(t, p);
+      const double m = *std::min_element(b.begin(), b.end());
+      if (m > best_minimum)
+      {
+        best_minimum     = m;
+        best             = t;
+        best_coordinates = b;
+      }
+    };
+    std::uint32_t     j         = mt->vertex_node[v];
+    const std::size_t first_cut = mt->vertices.size() - mt->cut_origin.size();
+    if (v >= first_cut)
+    {
+      // A vertex a cut created: it can come in with any node whose fragments contain
+      // it, applied or undone. Start from the node that inserts the tet whose split
+      // created it; if that node was applied, walk down through the destroyers of the
+      // tets containing p until one was not applied (that tet was active).
+      j = mt->creator[mt->cut_origin[v - first_cut]];
+      if (was_applied(j))
+        while (true)
+        {
+          best_minimum = -1e300;
+          mt->for_each_fine(j, consider);
+          const std::uint32_t child = mt->destroyer[best];
+          if (child == mesh::invalid_index || !was_applied(child))
+            return {best, best_coordinates};
+          j = child;
+        }
+    }
     while (true)
     {
-      // The coarse tets of j (which the collapse of its vertex created) tile its star;
-      // take the one that contains p, or the one p is least outside of.
-      std::uint32_t         best = mesh::invalid_index;
-      std::array<double, 4> best_coordinates{};
-      double                best_minimum = -1e300;
-      for (std::uint32_t k = mt->coarse_begin[j]; k < mt->coarse_begin[j + 1]; ++k)
-      {
-        const std::uint32_t t = mt->coarse_list[k];
-        const auto          b = mt->barycentric(t, p);
-        const double        m = *std::min_element(b.begin(), b.end());
-        if (m > best_minimum)
-        {
-          best_minimum     = m;
-          best             = t;
-          best_coordinates = b;
-        }
-      }
+      // The coarse tets of j (which the collapse of its vertex created) tile its star.
+      best_minimum = -1e300;
+      mt->for_each_coarse(j, consider);
       // Its destroyer (j) was not applied before; if its creator was, it was active.
       const std::uint32_t parent = mt->creator[best];
       if (was_applied(parent))

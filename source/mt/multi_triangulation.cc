@@ -12,7 +12,7 @@ namespace lacerta::mt
               + coarse_begin.capacity() + coarse_list.capacity() + node_vertex.capacity()
               + vertex_node.capacity())
                * sizeof(std::uint32_t)
-           + error.capacity() * sizeof(double)
+           + replaced.capacity() + error.capacity() * sizeof(double)
            + ball.capacity() * sizeof(std::array<double, 4>);
   }
 
@@ -37,27 +37,38 @@ namespace lacerta::mt
     if (n == 0 || fine_begin.size() != n + 1 || coarse_begin.size() != n + 1
         || error.size() != n || ball.size() != n || creator.size() != tets.size()
         || destroyer.size() != tets.size() || vertex_node.size() != vertices.size()
-        || fine_begin.front() != 0 || fine_begin.back() != tets.size()
-        || coarse_begin.front() != 0 || coarse_begin.back() != coarse_list.size())
+        || fine_begin.front() != 0
+        // Tets beyond the decimation's ranges are children a cut appended.
+        || (replaced.empty() ? fine_begin.back() != tets.size()
+                             : fine_begin.back() > tets.size())
+        || coarse_begin.front() != 0 || coarse_begin.back() != coarse_list.size()
+        || (!cut_fine.empty() && (cut_fine.size() != n || cut_coarse.size() != n))
+        || (!replaced.empty() && replaced.size() != tets.size())
+        || cut_origin.size() > vertices.size())
       throw_error("Multi-Triangulation '", source, "': inconsistent array sizes.");
     for (std::size_t j = 0; j < n; ++j)
     {
       if (fine_begin[j] > fine_begin[j + 1] || coarse_begin[j] > coarse_begin[j + 1])
         throw_error("Multi-Triangulation '", source, "': node ", j, " has bad ranges.");
-      for (std::uint32_t t = fine_begin[j]; t < fine_begin[j + 1]; ++t)
-        if (creator[t] != j)
-          throw_error("Multi-Triangulation '", source, "': tet ", t, " misplaced.");
-      for (std::uint32_t k = coarse_begin[j]; k < coarse_begin[j + 1]; ++k)
-        if (coarse_list[k] >= tets.size() || destroyer[coarse_list[k]] != j
-            || creator[coarse_list[k]] >= j)
-          throw_error("Multi-Triangulation '",
-                      source,
-                      "': node ",
-                      j,
-                      " removes a tet it does not own or that a later node inserts.");
-      if (j > 0
-          && (node_vertex[j] >= vertices.size()
-              || coarse_begin[j] == coarse_begin[j + 1]))
+      for_each_fine(j,
+                    [&](const std::uint32_t t)
+                    {
+                      if (t >= tets.size() || creator[t] != j || !is_live(t))
+                        throw_error(
+                          "Multi-Triangulation '", source, "': tet ", t, " misplaced.");
+                    });
+      for_each_coarse(
+        j,
+        [&](const std::uint32_t t)
+        {
+          if (t >= tets.size() || destroyer[t] != j || creator[t] >= j || !is_live(t))
+            throw_error("Multi-Triangulation '",
+                        source,
+                        "': node ",
+                        j,
+                        " removes a tet it does not own or that a later node inserts.");
+        });
+      if (j > 0 && (node_vertex[j] >= vertices.size() || n_coarse(j) == 0))
         throw_error(
           "Multi-Triangulation '",
           source,
@@ -65,12 +76,17 @@ namespace lacerta::mt
           j,
           " has no vertex or no coarse tetrahedra (it could never be applied).");
     }
+    for (const std::uint32_t t : cut_origin)
+      if (t >= tets.size())
+        throw_error("Multi-Triangulation '", source, "': a cut vertex has a bad origin.");
     for (std::size_t t = 0; t < tets.size(); ++t)
     {
       for (const unsigned int v : tets[t])
         if (v >= vertices.size())
           throw_error("Multi-Triangulation '", source, "': tet ", t, " bad vertex.");
-      if (destroyer[t] != mesh::invalid_index && destroyer[t] >= n)
+      if (creator[t] >= n
+          || (destroyer[t] != mesh::invalid_index
+              && (destroyer[t] >= n || destroyer[t] <= creator[t])))
         throw_error("Multi-Triangulation '", source, "': tet ", t, " bad destroyer.");
       const auto &[a, b, c, d] = tets[t];
       if (!(mesh::signed_volume(vertices[a], vertices[b], vertices[c], vertices[d]) > 0))

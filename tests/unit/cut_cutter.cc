@@ -71,17 +71,15 @@ namespace
     void
     stroke(const std::vector<Blade> &path, const unsigned int steps)
     {
-      for (std::size_t k = 0; k + 1 < path.size(); ++k)
-        for (unsigned int s = 1; s <= steps; ++s)
-        {
-          const double f = double(s) / steps;
-          cutter->move_blade({cut::lerp(path[k].tail, path[k + 1].tail, f),
-                              cut::lerp(path[k].head, path[k + 1].head, f)});
-          expect_invariants("segment " + std::to_string(k) + " step "
-                            + std::to_string(s));
-          if (::testing::Test::HasFatalFailure())
-            return;
-        }
+      cut::test_support::stroke(*cutter,
+                                path,
+                                steps,
+                                [&](const std::size_t k, const unsigned int s)
+                                {
+                                  expect_invariants("segment " + std::to_string(k)
+                                                    + " step " + std::to_string(s));
+                                  return !::testing::Test::HasFatalFailure();
+                                });
     }
 
     /// Volumes of the connected components, sorted.

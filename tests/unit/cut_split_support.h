@@ -8,6 +8,7 @@
  */
 #pragma once
 
+#include <lacerta/cut/cutter.h>
 #include <lacerta/cut/geometry.h>
 #include <lacerta/cut/split_table.h>
 
@@ -707,5 +708,27 @@ namespace lacerta::cut::test_support
         if (p[0][k] == w && p[1][k] == w && p[2][k] == w)
           return true;
     return false;
+  }
+
+  /**
+   * Moves @p cutter's blade through @p path in @p steps equal steps per segment,
+   * calling @p after_step(segment, step) after each; stops when it returns false.
+   */
+  template <typename Function>
+  void
+  stroke(Cutter                   &cutter,
+         const std::vector<Blade> &path,
+         const unsigned int        steps,
+         const Function           &after_step)
+  {
+    for (std::size_t k = 0; k + 1 < path.size(); ++k)
+      for (unsigned int s = 1; s <= steps; ++s)
+      {
+        const double f = double(s) / steps;
+        cutter.move_blade({lerp(path[k].tail, path[k + 1].tail, f),
+                           lerp(path[k].head, path[k + 1].head, f)});
+        if (!after_step(k, s))
+          return;
+      }
   }
 } // namespace lacerta::cut::test_support

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "mt_test_support.h"
 #include "physics_test_support.h"
 #include <algorithm>
 #include <cmath>
@@ -23,19 +24,7 @@ namespace lacerta
   {
     using mesh::Point3;
     using mesh::Tet;
-
-    /// A query from a name and parameters, as a scene would make it.
-    std::unique_ptr<mt::LodQuery>
-    make_query(const std::string &name, const std::map<std::string, std::string> &values)
-    {
-      dealii::ParameterHandler prm;
-      mt::LodQueryRegistry::declare_all_in_subsections(prm);
-      prm.enter_subsection(mt::LodQueryRegistry::subsection_name(name));
-      for (const auto &[entry, value] : values)
-        prm.set(entry, value);
-      prm.leave_subsection();
-      return mt::LodQueryRegistry::create_and_parse(name, prm);
-    }
+    using test_support::make_query;
 
     std::set<Tet>
     sorted_tets(const std::vector<Tet> &tets)

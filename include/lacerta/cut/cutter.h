@@ -6,6 +6,7 @@
 #pragma once
 
 #include <lacerta/cut/boundary_face_tree.h>
+#include <lacerta/cut/cut_record.h>
 #include <lacerta/cut/split_table.h>
 #include <lacerta/cut/tool.h>
 #include <lacerta/mesh/tet_mesh.h>
@@ -110,6 +111,17 @@ namespace lacerta::cut
       return current;
     }
 
+    /**
+     * Appends a CutRecord to @p records for every sweep that changes the mesh from now
+     * on (nullptr stops recording): what the Multi-Triangulation update needs
+     * (mt/mt_cutter.h).
+     */
+    void
+    set_recorder(std::vector<CutRecord> *records)
+    {
+      recorder = records;
+    }
+
     /// The active tetrahedra A_t (those the blade is in).
     const std::vector<unsigned int> &
     active_tets() const
@@ -164,5 +176,7 @@ namespace lacerta::cut
     std::vector<std::uint8_t>           on_surface;
     std::vector<unsigned int>           on_surface_list;
     std::vector<BoundaryFaceTree::Face> hits;
+    /// Where sweeps are recorded (set_recorder()), or nullptr.
+    std::vector<CutRecord> *recorder = nullptr;
   };
 } // namespace lacerta::cut

@@ -83,7 +83,9 @@ namespace lacerta::cut
    * Whether the segment [p, q] meets the triangle (a, b, c), boundaries included; on a
    * hit @p t is the parameter along the segment. Möller-Trumbore; a segment lying in
    * the triangle's plane counts as no hit (the cutter treats it through the plane
-   * sides instead).
+   * sides instead). A positive @p tolerance widens the barycentric and segment ranges
+   * by that much, so that a segment through an edge shared by two triangles is found
+   * by one of them despite rounding.
    */
   inline bool
   segment_hits_triangle(const Point &p,
@@ -91,7 +93,8 @@ namespace lacerta::cut
                         const Point &a,
                         const Point &b,
                         const Point &c,
-                        double      &t)
+                        double      &t,
+                        const double tolerance = 0)
   {
     const Point  d   = sub(q, p);
     const Point  e1  = sub(b, a);
@@ -103,14 +106,14 @@ namespace lacerta::cut
       return false;
     const Point  s = sub(p, a);
     const double u = dot(s, h) / det;
-    if (u < 0 || u > 1)
+    if (u < -tolerance || u > 1 + tolerance)
       return false;
     const Point  r = cross(s, e1);
     const double v = dot(d, r) / det;
-    if (v < 0 || u + v > 1)
+    if (v < -tolerance || u + v > 1 + tolerance)
       return false;
     t = dot(e2, r) / det;
-    return t >= 0 && t <= 1;
+    return t >= -tolerance && t <= 1 + tolerance;
   }
 
   /// Whether two triangles intersect (an edge of one crosses the other).

@@ -93,6 +93,13 @@ namespace lacerta::mt
     make_mesh(const std::vector<std::uint32_t> &vertices, const std::string &name) const;
 
     /**
+     * Follows a cut (MtCutter) that replaced MT tet @p parent by @p children: if the
+     * parent was active, the children are now. Call after the MT's fragments changed.
+     */
+    void
+    follow_cut(std::uint32_t parent, const std::vector<std::uint32_t> &children);
+
+    /**
      * For a vertex @p v that the last extract() brought in, the tetrahedron of the
      * previous level of detail that contains its rest position, found by walking up
      * the MT from the fragment that removed it (Section 4.2), and v's barycentric

@@ -27,7 +27,9 @@ namespace lacerta::mt
    * conforming mesh: the tets whose creator is applied and whose destroyer is not.
    *
    * Vertices are those of the input mesh with their ids: decimation removes vertices and
-   * never invents any, so particles keep their vertex id at every level of detail.
+   * never invents any, so particles keep their vertex id at every level of detail. A
+   * cut (mt/mt_cutter.h) replaces the tetrahedra it crosses by their children, which
+   * keep their parent's creator and destroyer, and appends the vertices it creates.
    */
   class MultiTriangulation
   {
@@ -62,6 +64,22 @@ namespace lacerta::mt
      * node is never above that over the balls of its descendants.
      */
     std::vector<std::array<double, 4>> ball;
+    /**
+     * Fragments cuts have changed (mt/mt_cutter.h): per node, its fine (coarse)
+     * tetrahedra once a cut has split one of them, in place of the range (list) above;
+     * an empty vector means the fragment is unchanged. Both are empty (no entry per
+     * node) until the first cut, and are not stored in MT files.
+     */
+    std::vector<std::vector<std::uint32_t>> cut_fine, cut_coarse;
+    /// Per tet: 1 if a cut replaced it by its children (then it is in no fragment);
+    /// empty until the first cut.
+    std::vector<std::uint8_t> replaced;
+    /**
+     * For the vertices cuts created, the last cut_origin.size() ones: the tet whose
+     * split created each (a level of detail that brings the vertex in finds the
+     * previous level's tet around it from there). Empty until the first cut.
+     */
+    std::vector<std::uint32_t> cut_origin;
 
     /// Number of nodes (the root included).
     unsigned int
@@ -88,14 +106,51 @@ namespace lacerta::mt
     unsigned int
     n_fine(const unsigned int j) const
     {
-      return fine_begin[j + 1] - fine_begin[j];
+      return cut_fine.empty() || cut_fine[j].empty()
+               ? fine_begin[j + 1] - fine_begin[j]
+               : static_cast<unsigned int>(cut_fine[j].size());
     }
 
     /// Number of tetrahedra node @p j removes.
     unsigned int
     n_coarse(const unsigned int j) const
     {
-      return coarse_begin[j + 1] - coarse_begin[j];
+      return cut_coarse.empty() || cut_coarse[j].empty()
+               ? coarse_begin[j + 1] - coarse_begin[j]
+               : static_cast<unsigned int>(cut_coarse[j].size());
+    }
+
+    /// Calls @p f(t) for every tet t node @p j inserts (its fine fragment).
+    template <typename Function>
+    void
+    for_each_fine(const unsigned int j, const Function &f) const
+    {
+      if (cut_fine.empty() || cut_fine[j].empty())
+        for (std::uint32_t t = fine_begin[j]; t < fine_begin[j + 1]; ++t)
+          f(t);
+      else
+        for (const std::uint32_t t : cut_fine[j])
+          f(t);
+    }
+
+    /// Calls @p f(t) for every tet t node @p j removes (its coarse fragment).
+    template <typename Function>
+    void
+    for_each_coarse(const unsigned int j, const Function &f) const
+    {
+      if (cut_coarse.empty() || cut_coarse[j].empty())
+        for (std::uint32_t k = coarse_begin[j]; k < coarse_begin[j + 1]; ++k)
+          f(coarse_list[k]);
+      else
+        for (const std::uint32_t t : cut_coarse[j])
+          f(t);
+    }
+
+    /// Whether tet @p t belongs to the MT (a cut has not replaced it).
+    bool
+    is_live(const std::uint32_t t) const
+    {
+      return replaced.empty() || replaced[t] == 0;
     }
 
     /// Bytes held by the arrays.

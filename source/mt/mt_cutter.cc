@@ -1,0 +1,548 @@
+#include <lacerta/base/exceptions.h>
+#include <lacerta/mt/mt_cutter.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+#include <tuple>
+
+namespace lacerta::mt
+{
+  namespace
+  {
+    using cut::NodeKind;
+    using cut::Point;
+
+    /// Identity of a point a sweep creates, in MT vertex ids (sorted).
+    struct Key
+    {
+      NodeKind                     kind;
+      std::int8_t                  side;
+      std::array<std::uint32_t, 4> ids;
+
+      bool
+      operator<(const Key &o) const
+      {
+        return std::tie(kind, side, ids) < std::tie(o.kind, o.side, o.ids);
+      }
+    };
+
+    template <std::size_t n>
+    std::array<std::uint32_t, 4>
+    sorted_ids(std::array<std::uint32_t, n> ids)
+    {
+      std::sort(ids.begin(), ids.end());
+      std::array<std::uint32_t, 4> result{};
+      std::copy(ids.begin(), ids.end(), result.begin());
+      return result;
+    }
+
+    std::pair<std::uint32_t, std::uint32_t>
+    edge_key(const std::uint32_t a, const std::uint32_t b)
+    {
+      return {std::min(a, b), std::max(a, b)};
+    }
+
+    /// The position of a node of a child of @p c split into @p r.
+    Point
+    node_position(const cut::TetCut &c, const cut::SplitResult &r, const cut::NodeRef &n)
+    {
+      switch (n.kind)
+      {
+        case NodeKind::vertex:
+          return c.points[n.index];
+        case NodeKind::edge_point:
+          return r.edge_points[n.index];
+        case NodeKind::face_point:
+          return r.face_points[n.index];
+        case NodeKind::interior_point:
+          break;
+      }
+      return r.interior_point;
+    }
+  } // namespace
+
+
+  MtCutter::MtCutter(MultiTriangulation &mt_in, const double snap_fraction_in)
+      : mt(mt_in)
+      , snap_fraction(snap_fraction_in)
+  {
+    cut::Box all;
+    for (const auto &p : mt.vertices)
+      all.extend(p);
+    // About eight tetrahedra per cell: a query near the cut touches few cells.
+    const double target = std::max(1.0, mt.n_tets() / 8.0);
+    double       volume = 1;
+    for (unsigned int d = 0; d < 3; ++d)
+      volume *= std::max(all.upper[d] - all.lower[d], 1e-12);
+    cell   = std::cbrt(volume / target);
+    origin = all.lower;
+    for (unsigned int d = 0; d < 3; ++d)
+      dims[d] = std::max(1u,
+                         std::min(1024u,
+                                  static_cast<unsigned int>(
+                                    std::ceil((all.upper[d] - all.lower[d]) / cell))));
+    cells.resize(std::size_t(dims[0]) * dims[1] * dims[2]);
+    vertex_tets.resize(mt.n_vertices());
+    for (std::uint32_t t = 0; t < mt.n_tets(); ++t)
+      if (mt.is_live(t))
+        index_tet(t);
+  }
+
+
+  cut::Box
+  MtCutter::tet_box(const std::uint32_t t) const
+  {
+    cut::Box box;
+    for (const auto v : mt.tets[t])
+      box.extend(mt.vertices[v]);
+    return box;
+  }
+
+
+  void
+  MtCutter::index_tet(const std::uint32_t t)
+  {
+    for_each_cell(tet_box(t), [&](const std::size_t k) { cells[k].push_back(t); });
+    if (vertex_tets.size() < mt.n_vertices())
+      vertex_tets.resize(mt.n_vertices());
+    for (const auto v : mt.tets[t])
+      vertex_tets[v].push_back(t);
+  }
+
+
+  void
+  MtCutter::query(const cut::Box &box, std::vector<std::uint32_t> &out)
+  {
+    seen.resize(mt.n_tets(), 0);
+    if (++stamp == 0)
+    {
+      std::fill(seen.begin(), seen.end(), 0);
+      stamp = 1;
+    }
+    for_each_cell(box,
+                  [&](const std::size_t k)
+                  {
+                    for (const std::uint32_t t : cells[k])
+                      if (seen[t] != stamp)
+                      {
+                        seen[t] = stamp;
+                        if (mt.is_live(t) && tet_box(t).overlaps(box))
+                          out.push_back(t);
+                      }
+                  });
+  }
+
+
+  void
+  MtCutter::replace_in_fragments(const std::uint32_t               parent,
+                                 const std::vector<std::uint32_t> &children)
+  {
+    const auto replace = [&](std::vector<std::uint32_t> &list)
+    {
+      auto it = std::find(list.begin(), list.end(), parent);
+      if (it == list.end())
+        throw_error("MtCutter: internal error, tet ", parent, " not in its fragment.");
+      *it = children.front();
+      list.insert(list.end(), children.begin() + 1, children.end());
+    };
+    const std::uint32_t c = mt.creator[parent];
+    if (mt.cut_fine[c].empty())
+      for (std::uint32_t t = mt.fine_begin[c]; t < mt.fine_begin[c + 1]; ++t)
+        mt.cut_fine[c].push_back(t);
+    replace(mt.cut_fine[c]);
+    const std::uint32_t d = mt.destroyer[parent];
+    if (d == mesh::invalid_index)
+      return;
+    if (mt.cut_coarse[d].empty())
+      for (std::uint32_t k = mt.coarse_begin[d]; k < mt.coarse_begin[d + 1]; ++k)
+        mt.cut_coarse[d].push_back(mt.coarse_list[k]);
+    replace(mt.cut_coarse[d]);
+  }
+
+
+  MtCutter::Statistics
+  MtCutter::apply(const std::vector<cut::CutRecord> &records, Lod *lod)
+  {
+    const auto start = std::chrono::steady_clock::now();
+    Statistics statistics;
+    if (mt.replaced.empty())
+      mt.replaced.assign(mt.n_tets(), 0);
+    if (mt.cut_fine.empty())
+    {
+      mt.cut_fine.resize(mt.n_nodes());
+      mt.cut_coarse.resize(mt.n_nodes());
+    }
+    const double eps = snap_fraction;
+
+    // 1. The rest cut surface: the cut faces of the +1 children of every recorded
+    // split, normals towards +1, in a grid like the tets'.
+    std::vector<std::array<Point, 3>>       surface;
+    std::vector<Point>                      normal;
+    std::vector<std::vector<std::uint32_t>> surface_cells(cells.size());
+    std::vector<cut::Box>                   regions;
+    for (const auto &record : records)
+    {
+      cut::Box region;
+      for (const auto &c : record.cuts)
+      {
+        for (const auto &p : c.points)
+          region.extend(p);
+        cut::SplitResult r;
+        cut::split_tetrahedron(c, r, eps);
+        for (unsigned int i = 0; i < r.n_children; ++i)
+        {
+          const cut::Child &child = r.children[i];
+          if (child.side == 0)
+            continue;
+          for (unsigned int j = 0; j < 4; ++j)
+            if ((child.cut_faces >> j) & 1u)
+            {
+              std::array<Point, 3> tri;
+              for (unsigned int k = 0; k < 3; ++k)
+                tri[k] = node_position(c, r, child.nodes[(j + 1 + k) % 4]);
+              Point n = cut::cross(cut::sub(tri[1], tri[0]), cut::sub(tri[2], tri[0]));
+              if (cut::dot(n, cut::sub(node_position(c, r, child.nodes[j]), tri[0]))
+                    * child.side
+                  < 0)
+                n = cut::scale(-1, n);
+              cut::Box box;
+              for (const auto &p : tri)
+                box.extend(p);
+              for_each_cell(box,
+                            [&](const std::size_t k) {
+                              surface_cells[k].push_back(
+                                static_cast<std::uint32_t>(surface.size()));
+                            });
+              surface.push_back(tri);
+              normal.push_back(n);
+            }
+        }
+      }
+      if (!record.cuts.empty())
+        regions.push_back(region);
+    }
+    if (surface.empty())
+      return statistics;
+    // The surface triangles near a box (each at most once per call).
+    std::vector<std::uint32_t> triangle_seen(surface.size(), 0);
+    std::uint32_t              triangle_stamp = 0;
+    const auto near_triangles = [&](const cut::Box &box, std::vector<std::uint32_t> &out)
+    {
+      out.clear();
+      ++triangle_stamp;
+      for_each_cell(box,
+                    [&](const std::size_t k)
+                    {
+                      for (const std::uint32_t t : surface_cells[k])
+                        if (triangle_seen[t] != triangle_stamp)
+                        {
+                          triangle_seen[t] = triangle_stamp;
+                          out.push_back(t);
+                        }
+                    });
+    };
+
+    // 2. The MT tetrahedra near the surface; the crossings of their edges, once per
+    // edge, snapped by the cutter's rule.
+    std::vector<std::uint32_t> candidates;
+    for (const auto &region : regions)
+      query(region, candidates);
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    std::set<std::uint32_t> in_candidates(candidates.begin(), candidates.end());
+    std::map<std::pair<std::uint32_t, std::uint32_t>, double> edge_t; // -1: not cut
+    std::set<std::uint32_t>                                   on_cut;
+    std::map<std::uint32_t, std::int8_t>                      hint;
+    std::vector<std::uint32_t>                                near;
+    const auto evaluate_edge = [&](const std::uint32_t a, const std::uint32_t b)
+    {
+      const auto key = edge_key(a, b);
+      if (edge_t.count(key))
+        return;
+      double      result = -1;
+      const Point p = mt.vertices[key.first], q = mt.vertices[key.second];
+      cut::Box    box;
+      box.extend(p);
+      box.extend(q);
+      near_triangles(box, near);
+      for (const std::uint32_t k : near)
+      {
+        double s;
+        if (!cut::segment_hits_triangle(
+              p, q, surface[k][0], surface[k][1], surface[k][2], s, 1e-10))
+          continue;
+        // A crossing at a vertex puts the vertex on the cut: the edge is not cut.
+        s                        = std::clamp(s, 0.0, 1.0);
+        const cut::EdgeSnap snap = cut::snap_edge_parameter(s, eps);
+        if (snap == cut::EdgeSnap::first_vertex)
+          on_cut.insert(key.first);
+        else if (snap == cut::EdgeSnap::second_vertex)
+          on_cut.insert(key.second);
+        else
+        {
+          result = s;
+          const std::int8_t side_p =
+            cut::dot(normal[k], cut::sub(p, surface[k][0])) >= 0 ? 1 : -1;
+          hint.emplace(key.first, side_p);
+          hint.emplace(key.second, -side_p);
+        }
+        break;
+      }
+      edge_t[key] = result;
+    };
+    // A vertex the cutter put on the cut is a corner of the surface, exactly.
+    {
+      std::set<Point> corners;
+      for (const auto &tri : surface)
+        corners.insert(tri.begin(), tri.end());
+      for (const std::uint32_t t : candidates)
+        for (const std::uint32_t v : mt.tets[t])
+          if (corners.count(mt.vertices[v]))
+            on_cut.insert(v);
+    }
+    // The whole star of a vertex on the cut is split (each side takes its copy).
+    std::set<std::uint32_t> star_added;
+    for (std::size_t q = 0; q < candidates.size(); ++q)
+    {
+      const auto tet = mt.tets[candidates[q]];
+      for (const auto &e : cut::tet_edge_vertices)
+        evaluate_edge(tet[e[0]], tet[e[1]]);
+      if (q + 1 == candidates.size())
+        for (const std::uint32_t v : on_cut)
+          if (star_added.insert(v).second)
+            for (const std::uint32_t t : vertex_tets[v])
+              if (mt.is_live(t) && in_candidates.insert(t).second)
+                candidates.push_back(t);
+    }
+    // Sides: from a crossing edge, else the plane of the nearest surface triangle.
+    std::map<std::uint32_t, std::int8_t> side;
+    const auto off_cut_side = [&](const std::uint32_t v) -> std::int8_t
+    {
+      const auto ih = hint.find(v);
+      if (ih != hint.end())
+        return ih->second;
+      cut::Box box;
+      box.extend(mt.vertices[v]);
+      near_triangles(box, near);
+      if (near.empty())
+        for (std::uint32_t k = 0; k < surface.size(); ++k)
+          near.push_back(k);
+      double      best = 1e300;
+      std::int8_t s    = 1;
+      for (const std::uint32_t k : near)
+      {
+        const Point centre =
+          cut::scale(1.0 / 3,
+                     cut::add(surface[k][0], cut::add(surface[k][1], surface[k][2])));
+        const Point  d  = cut::sub(mt.vertices[v], centre);
+        const double d2 = cut::dot(d, d);
+        if (d2 < best)
+        {
+          best = d2;
+          s = cut::dot(normal[k], cut::sub(mt.vertices[v], surface[k][0])) >= 0 ? 1 : -1;
+        }
+      }
+      return s;
+    };
+    const auto side_of = [&](const std::uint32_t v)
+    {
+      auto it = side.find(v);
+      if (it == side.end())
+        it = side.emplace(v, on_cut.count(v) ? 0 : off_cut_side(v)).first;
+      return it->second;
+    };
+
+    // 3. The split of every candidate, from per-edge and per-vertex data only, so
+    // that neighbours at every level of detail agree.
+    struct Split
+    {
+      std::uint32_t    tet;
+      cut::TetCut      cut;
+      cut::SplitResult result;
+    };
+    std::vector<Split> splits;
+    const auto         make_cut = [&](const std::uint32_t t, Split &s)
+    {
+      const auto &ids = mt.tets[t];
+      s.tet           = t;
+      s.cut           = cut::TetCut();
+      bool touched    = false;
+      for (unsigned int i = 0; i < 4; ++i)
+      {
+        s.cut.vertex_ids[i]  = ids[i];
+        s.cut.points[i]      = mt.vertices[ids[i]];
+        s.cut.vertex_side[i] = side_of(ids[i]);
+        touched |= s.cut.vertex_side[i] == 0;
+      }
+      for (unsigned int e = 0; e < 6; ++e)
+      {
+        const unsigned int i = cut::tet_edge_vertices[e][0],
+                           j = cut::tet_edge_vertices[e][1];
+        const double p       = edge_t.at(edge_key(ids[i], ids[j]));
+        if (p >= 0 && s.cut.vertex_side[i] * s.cut.vertex_side[j] < 0)
+        {
+          s.cut.cut_edges |= std::uint8_t(1u << e);
+          s.cut.edge_parameter[e] = p;
+          touched                 = true;
+        }
+      }
+      return touched;
+    };
+    // Where the surface ends inside a tetrahedron (a crack front, or a bridge the
+    // cutter left), the table refines it without separating: the points on its cut
+    // edges are not separated in any tetrahedron, so the crack closes there.
+    std::set<std::pair<std::uint32_t, std::uint32_t>> closed;
+    for (const std::uint32_t t : candidates)
+    {
+      Split s;
+      if (!make_cut(t, s))
+        continue;
+      const cut::CutKind kind = cut::split_tetrahedron(s.cut, s.result, eps);
+      if (kind == cut::CutKind::none)
+        continue;
+      if (kind != cut::CutKind::complete && kind != cut::CutKind::touch)
+        for (unsigned int e = 0; e < 6; ++e)
+          if ((s.cut.cut_edges >> e) & 1u)
+            closed.insert(edge_key(s.cut.vertex_ids[cut::tet_edge_vertices[e][0]],
+                                   s.cut.vertex_ids[cut::tet_edge_vertices[e][1]]));
+      splits.push_back(s);
+    }
+
+    // 4. The children, with the cut points merged by edge and side, and the vertices
+    // on the cut copied per group of children around them connected through faces
+    // not on the cut (as the cutter does, over every level of detail at once).
+    std::map<Key, std::uint32_t> point_of;
+    const auto new_vertex = [&](const Point &x, const std::uint32_t origin_tet)
+    {
+      const auto id = static_cast<std::uint32_t>(mt.vertices.size());
+      mt.vertices.push_back(x);
+      mt.vertex_node.push_back(mt.creator[origin_tet]);
+      mt.cut_origin.push_back(origin_tet);
+      vertex_tets.resize(mt.vertices.size());
+      ++statistics.new_vertices;
+      return id;
+    };
+    std::vector<mesh::Tet>                            children;
+    std::vector<std::uint8_t>                         child_cut_faces;
+    std::vector<std::size_t>                          child_split;
+    std::map<std::uint32_t, std::vector<std::size_t>> incident;
+    for (std::size_t k = 0; k < splits.size(); ++k)
+    {
+      const Split &s = splits[k];
+      for (unsigned int i = 0; i < s.result.n_children; ++i)
+      {
+        const cut::Child &child = s.result.children[i];
+        mesh::Tet         tet;
+        for (unsigned int j = 0; j < 4; ++j)
+        {
+          const cut::NodeRef &n = child.nodes[j];
+          const auto         &v = s.cut.vertex_ids;
+          if (n.kind == NodeKind::vertex)
+          {
+            tet[j] = static_cast<std::uint32_t>(v[n.index]);
+            if (s.cut.vertex_side[n.index] == 0)
+              incident[tet[j]].push_back(children.size());
+            continue;
+          }
+          // Without fronts every new point is a point on an edge, separated unless
+          // the crack closes there.
+          const auto &e    = cut::tet_edge_vertices[n.index];
+          const auto  edge = edge_key(static_cast<std::uint32_t>(v[e[0]]),
+                                     static_cast<std::uint32_t>(v[e[1]]));
+          const Key   key  = {n.kind,
+                           closed.count(edge) ? std::int8_t(0) : n.side,
+                              {{edge.first, edge.second, 0, 0}}};
+          auto        it   = point_of.find(key);
+          if (it == point_of.end())
+            it =
+              point_of.emplace(key, new_vertex(node_position(s.cut, s.result, n), s.tet))
+                .first;
+          tet[j] = it->second;
+        }
+        children.push_back(tet);
+        child_cut_faces.push_back(child.cut_faces);
+        child_split.push_back(k);
+      }
+    }
+    for (const auto &[v, list] : incident)
+    {
+      std::vector<std::size_t> group(list.size());
+      for (std::size_t i = 0; i < list.size(); ++i)
+        group[i] = i;
+      const auto find = [&](std::size_t i)
+      {
+        while (group[i] != i)
+          i = group[i] = group[group[i]];
+        return i;
+      };
+      std::map<std::array<std::uint32_t, 3>, std::size_t> first_with_face;
+      for (std::size_t i = 0; i < list.size(); ++i)
+      {
+        const mesh::Tet &t = children[list[i]];
+        for (unsigned int f = 0; f < 4; ++f)
+        {
+          if (t[f] == v || ((child_cut_faces[list[i]] >> f) & 1u))
+            continue;
+          std::array<std::uint32_t, 3> face{
+            {t[(f + 1) % 4], t[(f + 2) % 4], t[(f + 3) % 4]}};
+          std::sort(face.begin(), face.end());
+          const auto [it, inserted] = first_with_face.emplace(face, i);
+          if (!inserted)
+            group[find(i)] = find(it->second);
+        }
+      }
+      std::map<std::size_t, std::uint32_t> copy_of_root;
+      for (std::size_t i = 0; i < list.size(); ++i)
+      {
+        const std::size_t root = find(i);
+        auto              it   = copy_of_root.find(root);
+        if (it == copy_of_root.end())
+          it =
+            copy_of_root
+              .emplace(root,
+                       copy_of_root.empty()
+                         ? v
+                         : new_vertex(mt.vertices[v], splits[child_split[list[i]]].tet))
+              .first;
+        for (auto &node : children[list[i]])
+          if (node == v)
+            node = it->second;
+      }
+    }
+
+    // 5. The MT: children appended with their parent's creator and destroyer.
+    std::vector<std::uint32_t> fragments;
+    for (std::size_t c = 0, k = 0; k < splits.size(); ++k)
+    {
+      const Split               &s = splits[k];
+      std::vector<std::uint32_t> ids;
+      for (; c < children.size() && child_split[c] == k; ++c)
+      {
+        const auto id = static_cast<std::uint32_t>(mt.tets.size());
+        mt.tets.push_back(children[c]);
+        mt.creator.push_back(mt.creator[s.tet]);
+        mt.destroyer.push_back(mt.destroyer[s.tet]);
+        mt.replaced.push_back(0);
+        ids.push_back(id);
+      }
+      mt.replaced[s.tet] = 1;
+      replace_in_fragments(s.tet, ids);
+      if (lod)
+        lod->follow_cut(s.tet, ids);
+      for (const std::uint32_t id : ids)
+        index_tet(id);
+      fragments.push_back(mt.creator[s.tet]);
+      ++statistics.cut_tets;
+      statistics.created_tets += static_cast<unsigned int>(ids.size());
+    }
+    std::sort(fragments.begin(), fragments.end());
+    statistics.split_fragments = static_cast<unsigned int>(
+      std::unique(fragments.begin(), fragments.end()) - fragments.begin());
+    statistics.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return statistics;
+  }
+} // namespace lacerta::mt

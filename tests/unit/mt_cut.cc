@@ -1,0 +1,368 @@
+// Cuts on the Multi-Triangulation (Section 5.1): a level of detail cut by the Cutter,
+// the MT updated from the cutter's records, and every extraction checked afterwards.
+#include <lacerta/cut/cutter.h>
+#include <lacerta/cut/invariants.h>
+#include <lacerta/mt/builder.h>
+#include <lacerta/mt/lod.h>
+#include <lacerta/mt/lod_query.h>
+#include <lacerta/mt/mt_cutter.h>
+#include <lacerta/physics/assembly.h>
+#include <lacerta/physics/particle_system.h>
+
+#include <deal.II/base/function.h>
+
+#include <gtest/gtest.h>
+
+#include "cut_split_support.h"
+#include "mt_test_support.h"
+#include "physics_test_support.h"
+#include <algorithm>
+#include <map>
+#include <random>
+#include <set>
+
+namespace lacerta
+{
+  namespace
+  {
+    using cut::Blade;
+    using mesh::Tet;
+
+    constexpr double density = 1000;
+
+    using test_support::make_query;
+
+    std::unique_ptr<mt::LodQuery>
+    uniform(const double h)
+    {
+      return make_query("uniform", {{"Cell size", std::to_string(h)}});
+    }
+
+    /// A unit box of 5^3 hexahedra split into tetrahedra, interior vertices jittered.
+    const mesh::TetMesh &
+    jittered_box()
+    {
+      static const mesh::TetMesh mesh =
+        test_support::distorted_box(5, 0.25, dealii::Point<3>(1, 1, 1));
+      return mesh;
+    }
+
+    /// A vertical blade through the whole box at (x, y), spanning z from -0.5 to 1.5.
+    Blade
+    vertical(const double x, const double y)
+    {
+      return {{{x, y, 1.5}}, {{x, y, -0.5}}};
+    }
+
+    /// A mesh with its particle system and a cutter, recording its sweeps.
+    struct CutMesh
+    {
+      mesh::TetMesh                            mesh;
+      std::unique_ptr<physics::ParticleSystem> system;
+      dealii::Functions::ConstantFunction<3>   sigma{density};
+      dealii::Functions::ConstantFunction<3>   youngs{1e4};
+      double                                   integral = density;
+      std::vector<cut::CutRecord>              records;
+      std::unique_ptr<cut::Cutter>             cutter;
+
+      CutMesh(mesh::TetMesh m, const Blade &start)
+          : mesh(std::move(m))
+          , system(test_support::make_system(mesh, density, 1e4))
+      {
+        integral = physics::integrate_over_mesh(mesh, sigma);
+        cutter   = std::make_unique<cut::Cutter>(
+          mesh, *system, sigma, youngs, integral, cut::Cutter::Parameters(), start);
+        cutter->set_recorder(&records);
+      }
+
+      /// Moves the blade through @p path, @p steps steps per segment.
+      void
+      stroke(const std::vector<Blade> &path, const unsigned int steps)
+      {
+        cut::test_support::stroke(*cutter,
+                                  path,
+                                  steps,
+                                  [](std::size_t, unsigned int) { return true; });
+      }
+    };
+
+    /// The active set is exactly the live tets whose creator is applied and whose
+    /// destroyer is not, and the applied set is closed under parents: every
+    /// root-to-leaf path of the DAG crosses exactly one arc of the front.
+    void
+    expect_front_of_dag(const mt::MultiTriangulation &mt, const mt::Lod &lod)
+    {
+      for (std::uint32_t t = 0; t < mt.n_tets(); ++t)
+      {
+        const bool expected =
+          mt.is_live(t) && lod.is_applied(mt.creator[t])
+          && (mt.destroyer[t] == mesh::invalid_index || !lod.is_applied(mt.destroyer[t]));
+        ASSERT_EQ(lod.is_active(t), expected) << "tet " << t;
+      }
+      for (std::uint32_t j = 1; j < mt.n_nodes(); ++j)
+        if (lod.is_applied(j))
+          mt.for_each_coarse(j,
+                             [&](const std::uint32_t t)
+                             { ASSERT_TRUE(lod.is_applied(mt.creator[t])) << j; });
+    }
+
+    /// Area of the boundary of @p m.
+    double
+    boundary_area(const mesh::TetMesh &m)
+    {
+      double area = 0;
+      for (const auto &f : m.get_boundary_faces())
+      {
+        const auto &l = mesh::TetMesh::face_vertices[f.face];
+        const Tet  &t = m.tet(f.tet);
+        area += 0.5
+                * cut::norm(cut::cross(cut::sub(m.vertex(t[l[1]]), m.vertex(t[l[0]])),
+                                       cut::sub(m.vertex(t[l[2]]), m.vertex(t[l[0]]))));
+      }
+      return area;
+    }
+
+    /**
+     * Extracts @p query from scratch and checks it: conforming with positive cells,
+     * the volume of the box, masses summing to ∫σ, @p components pieces (0: any) and
+     * the DAG front. Returns the mesh.
+     */
+    mesh::TetMesh
+    check_extraction(const mt::MultiTriangulation &mt,
+                     const mt::LodQuery           &query,
+                     const unsigned int            components,
+                     const std::string            &where)
+    {
+      mt::Lod lod(mt);
+      lod.extract(query);
+      expect_front_of_dag(mt, lod);
+      const auto    vertices = lod.active_vertices();
+      mesh::TetMesh m        = lod.make_mesh(vertices, "extraction");
+      const auto    system   = test_support::make_system(m, density, 1e4);
+      EXPECT_EQ(cut::check_invariants(m, *system, 1.0, density), "") << where;
+      if (components > 0)
+      {
+        EXPECT_EQ(cut::count_components(m), components) << where;
+      }
+      return m;
+    }
+
+    /// Uniform queries from finest to coarsest and focus queries around the cut.
+    void
+    check_all_levels(const mt::MultiTriangulation &mt, const unsigned int components)
+    {
+      for (const double h : {0.0, 0.2, 0.35, 0.6, 1000.0})
+        check_extraction(mt, *uniform(h), components, "uniform " + std::to_string(h));
+      for (const double radius : {0.1, 0.3})
+      {
+        auto query =
+          make_query("focus",
+                     {{"Radius", std::to_string(radius)}, {"Cell size growth", "0.5"}});
+        for (const mesh::Point3 &focus :
+             {mesh::Point3{{0.5, 0.5, 0.5}}, mesh::Point3{{0.1, 0.8, 0.3}}})
+        {
+          query->set_focus(focus);
+          check_extraction(mt, *query, components, "focus " + std::to_string(radius));
+        }
+      }
+    }
+
+    /// Cuts the level of detail @p query selects with @p path and updates the MT.
+    struct LodCut
+    {
+      mt::MultiTriangulation   mt;
+      mt::Lod                  lod;
+      std::unique_ptr<CutMesh> cut;
+      mt::MtCutter::Statistics statistics;
+
+      LodCut(const mt::LodQuery       &query,
+             const std::vector<Blade> &path,
+             unsigned int              steps)
+          : mt(mt::build_multi_triangulation(jittered_box(), mt::BuilderParameters()))
+          , lod(mt)
+      {
+        lod.extract(query);
+        cut =
+          std::make_unique<CutMesh>(lod.make_mesh(lod.active_vertices(), "lod"), path[0]);
+        cut->stroke(path, steps);
+        mt::MtCutter cutter(mt);
+        statistics = cutter.apply(cut->records, &lod);
+      }
+
+      /// The level of detail that followed the cut: the MT's version of the cut mesh,
+      /// a valid front of the DAG, with the same pieces as the cutter's mesh.
+      void
+      expect_lod_follows_the_cut(const bool same_pieces = true) const
+      {
+        expect_front_of_dag(mt, lod);
+        const mesh::TetMesh m      = lod.make_mesh(lod.active_vertices(), "followed");
+        const auto          system = test_support::make_system(m, density, 1e4);
+        EXPECT_EQ(cut::check_invariants(m, *system, 1.0, density), "");
+        if (!same_pieces)
+          return;
+        const auto a = cut::component_volumes(m), b = cut::component_volumes(cut->mesh);
+        ASSERT_EQ(a.size(), b.size());
+        // Snapping moves the surface by at most ε of an edge.
+        for (std::size_t k = 0; k < a.size(); ++k)
+          EXPECT_NEAR(a[k], b[k], 0.01);
+      }
+    };
+  } // namespace
+
+
+  TEST(MtCut, CutAtTheFinestLevelSplitsEveryLevelAlike)
+  {
+    LodCut c(*uniform(0), {vertical(-0.2, 0.43), vertical(1.2, 0.47)}, 12);
+    EXPECT_EQ(cut::count_components(c.cut->mesh), 2u);
+    EXPECT_NO_THROW(c.mt.check("cut MT"));
+    c.expect_lod_follows_the_cut();
+    EXPECT_GT(c.statistics.split_fragments, 10u);
+    // Coarser fragments are crossed too: the MT cuts more than the level of detail.
+    EXPECT_GT(c.statistics.cut_tets, c.cut->mesh.n_tets() / 10);
+    EXPECT_GT(c.statistics.created_tets, c.statistics.cut_tets);
+    check_all_levels(c.mt, 2);
+    // The finest extraction has the cut mesh's pieces and cut surface.
+    const mesh::TetMesh finest = check_extraction(c.mt, *uniform(0), 2, "finest");
+    const auto          a      = cut::component_volumes(finest),
+               b               = cut::component_volumes(c.cut->mesh);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t k = 0; k < a.size(); ++k)
+      EXPECT_NEAR(a[k], b[k], 0.01);
+    EXPECT_NEAR(boundary_area(finest), boundary_area(c.cut->mesh), 0.03);
+  }
+
+
+  TEST(MtCut, CutAtACoarseLevelMatchesTheFullResolutionCut)
+  {
+    const std::vector<Blade> path = {vertical(-0.2, 0.43), vertical(1.2, 0.47)};
+    LodCut                   c(*uniform(0.5), path, 12);
+    EXPECT_EQ(cut::count_components(c.cut->mesh), 2u);
+    EXPECT_NO_THROW(c.mt.check("cut MT"));
+    c.expect_lod_follows_the_cut();
+    check_all_levels(c.mt, 2);
+    // The full-resolution mesh cut directly by the same strokes.
+    CutMesh direct(jittered_box(), path[0]);
+    direct.stroke(path, 12);
+    const mesh::TetMesh finest = check_extraction(c.mt, *uniform(0), 2, "finest");
+    const auto          a      = cut::component_volumes(finest),
+               b               = cut::component_volumes(direct.mesh);
+    ASSERT_EQ(a.size(), 2u);
+    ASSERT_EQ(b.size(), 2u);
+    // Snapping moves the surface by at most ε of a (fine or coarse) edge.
+    for (std::size_t k = 0; k < 2; ++k)
+      EXPECT_NEAR(a[k], b[k], 0.01);
+    // The cut surface: the boundary minus the box's six faces, two sheets.
+    EXPECT_NEAR(boundary_area(finest) - 6, boundary_area(direct.mesh) - 6, 0.02);
+    EXPECT_NEAR(boundary_area(finest) - 6, 2.0, 0.05);
+  }
+
+
+  TEST(MtCut, PartialCutKeepsEveryLevelInOnePiece)
+  {
+    // A crack that ends inside the body: it closes where the cut surface ends, and
+    // every level of detail stays valid and in one piece.
+    LodCut c(*uniform(0.35), {vertical(-0.2, 0.52), vertical(0.55, 0.5)}, 8);
+    EXPECT_EQ(cut::count_components(c.cut->mesh), 1u);
+    EXPECT_GT(c.statistics.cut_tets, 0u);
+    EXPECT_GT(c.statistics.new_vertices, 0u);
+    EXPECT_NO_THROW(c.mt.check("cut MT"));
+    c.expect_lod_follows_the_cut();
+    check_all_levels(c.mt, 1);
+  }
+
+
+  TEST(MtCut, SecondCutAfterAFirstOneKeepsEveryLevelValid)
+  {
+    // Two complete strokes at different levels of detail: three pieces everywhere.
+    LodCut  c(*uniform(0), {vertical(-0.2, 0.3), vertical(1.2, 0.32)}, 10);
+    mt::Lod second(c.mt);
+    second.extract(*uniform(0.35));
+    CutMesh cut2(second.make_mesh(second.active_vertices(), "lod"), vertical(-0.2, 0.7));
+    cut2.stroke({vertical(-0.2, 0.7), vertical(1.2, 0.66)}, 10);
+    EXPECT_EQ(cut::count_components(cut2.mesh), 3u);
+    mt::MtCutter cutter(c.mt);
+    const auto   statistics = cutter.apply(cut2.records, &second);
+    EXPECT_GT(statistics.cut_tets, 0u);
+    EXPECT_NO_THROW(c.mt.check("twice cut MT"));
+    expect_front_of_dag(c.mt, second);
+    check_all_levels(c.mt, 3);
+  }
+
+
+  TEST(MtCut, RandomStrokesAtRandomLevelsKeepEveryLevelValid)
+  {
+    std::uniform_real_distribution<double> u(0.15, 0.85), angle(0, 3.14159), h(0, 0.6);
+    unsigned int                           separated = 0;
+    for (unsigned int seed = 0; seed < 4; ++seed)
+    {
+      std::mt19937     rng(300 + seed);
+      const double     phi = angle(rng), cx = u(rng), cy = u(rng);
+      const cut::Point dir{{std::cos(phi), std::sin(phi), 0}};
+      LodCut           c(*uniform(h(rng)),
+               {vertical(cx - dir[0], cy - dir[1]), vertical(cx + dir[0], cy + dir[1])},
+               6 + 2 * seed);
+      ASSERT_NO_THROW(c.mt.check("cut MT")) << "seed " << seed;
+      // Where the cutter postponed sweeps and left a bridge (doc/cutting.md), the
+      // MT, cut along the surface the cutter did open, may still separate.
+      c.expect_lod_follows_the_cut(false);
+      const mesh::TetMesh finest = check_extraction(c.mt, *uniform(0), 0, "finest");
+      const unsigned int  pieces = cut::count_components(finest);
+      EXPECT_LE(pieces, 2u);
+      separated += pieces == 2;
+      check_all_levels(c.mt, pieces);
+      ASSERT_FALSE(::testing::Test::HasFailure()) << "seed " << seed;
+    }
+    EXPECT_GE(separated, 3u);
+  }
+
+
+  TEST(MtCut, TheLevelOfDetailThatFollowedTheCutUpdatesLikeAFreshOne)
+  {
+    // The cut LOD's frontier bookkeeping stays right: updated incrementally from it,
+    // every query selects the same tets as an extraction from scratch.
+    LodCut c(*make_query("focus", {{"Radius", "0.2"}, {"Cell size growth", "0.5"}}),
+             {vertical(-0.2, 0.43), vertical(1.2, 0.47)},
+             12);
+    for (const double h : {0.0, 0.6, 0.2, 1000.0, 0.0})
+    {
+      const auto query = uniform(h);
+      c.lod.extract(*query);
+      mt::Lod fresh(c.mt);
+      fresh.extract(*query);
+      std::vector<std::uint32_t> a = c.lod.active_tets(), b = fresh.active_tets();
+      std::sort(a.begin(), a.end());
+      std::sort(b.begin(), b.end());
+      EXPECT_EQ(a, b) << "cell size " << h;
+      expect_front_of_dag(c.mt, c.lod);
+    }
+  }
+
+
+  TEST(MtCut, VerticesACutCreatedAreLocatedInThePreviousLevel)
+  {
+    LodCut            c(*uniform(0.5), {vertical(-0.2, 0.43), vertical(1.2, 0.47)}, 12);
+    const std::size_t first = c.mt.n_vertices() - c.mt.cut_origin.size();
+    ASSERT_GT(c.mt.cut_origin.size(), 0u);
+    // Coarse to fine and back: every vertex brought in by either extraction, cut
+    // vertices included, lies in a tet that was active before.
+    mt::Lod lod(c.mt);
+    lod.extract(*uniform(1000));
+    unsigned int located_cut_vertices = 0;
+    for (const double size : {0.0, 1000.0, 0.2})
+    {
+      const auto              before = lod.active_vertices();
+      std::set<std::uint32_t> active_before(lod.active_tets().begin(),
+                                            lod.active_tets().end());
+      lod.extract(*uniform(size));
+      for (const auto v : lod.active_vertices())
+        if (!std::binary_search(before.begin(), before.end(), v))
+        {
+          const auto [t, lambda] = lod.locate_in_previous(v);
+          EXPECT_TRUE(active_before.count(t)) << "vertex " << v;
+          EXPECT_GT(*std::min_element(lambda.begin(), lambda.end()), -0.1) << v;
+          located_cut_vertices += v >= first;
+        }
+    }
+    EXPECT_GT(located_cut_vertices, 0u);
+  }
+} // namespace lacerta
