@@ -938,6 +938,8 @@ namespace lacerta::mt
       // Errors and balls, children (earlier collapses, larger node ids) first.
       mt.error.assign(n_nodes, 0);
       mt.ball.assign(n_nodes, {{0, 0, 0, 0}});
+      mt.own_error.assign(n_nodes, 0);
+      mt.own_ball.assign(n_nodes, {{0, 0, 0, 0}});
       const auto volume = [&](const std::uint32_t t)
       {
         const Tet &c = mt.tets[t];
@@ -967,7 +969,9 @@ namespace lacerta::mt
         double radius = 0;
         for (const std::uint32_t p : points)
           radius = std::max(radius, distance(center, position[p]));
-        double error = mt.n_coarse(j) > 0 ? sum / mt.n_coarse(j) : 0;
+        double error    = mt.n_coarse(j) > 0 ? sum / mt.n_coarse(j) : 0;
+        mt.own_error[j] = error;
+        mt.own_ball[j]  = {{center[0], center[1], center[2], radius * (1 + 1e-12)}};
         for (std::uint32_t t = mt.fine_begin[j]; t < mt.fine_begin[j + 1]; ++t)
           if (const std::uint32_t c = mt.destroyer[t]; c != none)
           {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 
 namespace lacerta::mt
 {
@@ -16,6 +17,7 @@ namespace lacerta::mt
       , active_fine(mt.n_nodes(), 0)
       , need_stamp(mt.n_nodes(), 0)
       , need_value(mt.n_nodes(), 0)
+      , need_until(mt.n_nodes(), -std::numeric_limits<double>::infinity())
       , frontier_position(mt.n_nodes(), mesh::invalid_index)
       , check_at(mt.n_nodes(), 0)
   {
@@ -92,9 +94,8 @@ namespace lacerta::mt
   void
   Lod::schedule_check(const std::uint32_t j, const LodQuery &query)
   {
-    const auto  &b     = mt->ball[j];
-    const double slack = query.focus_slack({{b[0], b[1], b[2]}}, b[3], mt->error[j]);
-    check_at[j]        = query.focus_travel() + slack;
+    evaluate(j, query);
+    check_at[j] = need_until[j];
     if (std::isfinite(check_at[j]))
     {
       checks.push_back({check_at[j], j});
@@ -106,13 +107,97 @@ namespace lacerta::mt
   bool
   Lod::needs(const std::uint32_t j, const LodQuery &query)
   {
-    if (need_stamp[j] != stamp)
-    {
-      const auto &b = mt->ball[j];
-      need_stamp[j] = stamp;
-      need_value[j] = mt->error[j] > query.minimum_error({{b[0], b[1], b[2]}}, b[3]);
-    }
+    evaluate(j, query);
     return need_value[j] != 0;
+  }
+
+
+  bool
+  Lod::known(const std::uint32_t j) const
+  {
+    // Computed in this extraction, or earlier with a slack the focus has not
+    // travelled yet (need_until is reset when the query object changes).
+    return need_stamp[j] == stamp || travel < need_until[j];
+  }
+
+
+  bool
+  Lod::evaluate_own(const std::uint32_t j, const LodQuery &query)
+  {
+    need_stamp[j] = stamp;
+    // The bounds: neither j nor a descendant can fail where the query allows error[j]
+    // over ball[j].
+    const auto        &b = mt->ball[j];
+    const mesh::Point3 center{{b[0], b[1], b[2]}};
+    need_until[j] = travel + query.focus_slack(center, b[3], mt->error[j]);
+    if (!(mt->error[j] > query.minimum_error(center, b[3])))
+    {
+      need_value[j] = 0;
+      return true;
+    }
+    const auto        &o = mt->own_ball[j];
+    const mesh::Point3 own_center{{o[0], o[1], o[2]}};
+    need_until[j] =
+      std::min(need_until[j],
+               travel + query.focus_slack(own_center, o[3], mt->own_error[j]));
+    need_value[j] = mt->own_error[j] > query.minimum_error(own_center, o[3]);
+    // The root has no coarse fragment: it is always applied, whatever its children.
+    return need_value[j] != 0 || j == 0;
+  }
+
+
+  void
+  Lod::evaluate(const std::uint32_t j, const LodQuery &query)
+  {
+    if (known(j) || evaluate_own(j, query))
+      return;
+    // Depth first over the descendants whose bounds do not rule them out: j is needed
+    // as soon as one child is (and then stays so while that child does and j's bound
+    // allows), otherwise it is not, until the first of its own tests and its
+    // children's answers can change.
+    auto &stack = evaluation_stack;
+    stack.clear();
+    stack.push_back({j, mt->fine_begin[j]});
+    while (!stack.empty())
+    {
+      auto &[k, t] = stack.back();
+      if (t == mt->fine_begin[k + 1])
+      {
+        // No child of k is needed: neither is k.
+        const std::uint32_t done = k;
+        stack.pop_back();
+        if (!stack.empty())
+        {
+          const std::uint32_t parent = stack.back().first;
+          need_until[parent]         = std::min(need_until[parent], need_until[done]);
+        }
+        continue;
+      }
+      const std::uint32_t c = mt->destroyer[t++];
+      if (c == mesh::invalid_index)
+        continue;
+      if (!known(c) && !evaluate_own(c, query))
+      {
+        stack.push_back({c, mt->fine_begin[c]});
+        continue;
+      }
+      if (need_value[c] == 0)
+      {
+        need_until[k] = std::min(need_until[k], need_until[c]);
+        continue;
+      }
+      // c is needed: so are k and every node on the stack, for as long as c is and
+      // their bounds allow (the bounds' limits are already in their need_until).
+      double until = need_until[c];
+      while (!stack.empty())
+      {
+        const std::uint32_t a = stack.back().first;
+        stack.pop_back();
+        need_value[a] = 1;
+        until         = std::min(until, need_until[a]);
+        need_until[a] = until;
+      }
+    }
   }
 
 
@@ -158,11 +243,14 @@ namespace lacerta::mt
     // otherwise those that joined the frontier since their last test and those whose
     // slack the focus has travelled past (the others keep their need: they stay).
     std::vector<std::uint32_t> candidates;
-    const double               travel = query.focus_travel();
+    travel = query.focus_travel();
     if (query.identity() != query_identity)
     {
       query_identity = query.identity();
-      candidates     = frontier;
+      std::fill(need_until.begin(),
+                need_until.end(),
+                -std::numeric_limits<double>::infinity());
+      candidates = frontier;
       checks.clear();
     }
     else

@@ -12,8 +12,8 @@ namespace lacerta::mt
               + coarse_begin.capacity() + coarse_list.capacity() + node_vertex.capacity()
               + vertex_node.capacity())
                * sizeof(std::uint32_t)
-           + error.capacity() * sizeof(double)
-           + ball.capacity() * sizeof(std::array<double, 4>);
+           + (error.capacity() + own_error.capacity()) * sizeof(double)
+           + (ball.capacity() + own_ball.capacity()) * sizeof(std::array<double, 4>);
   }
 
 
@@ -35,7 +35,8 @@ namespace lacerta::mt
   {
     const std::size_t n = n_nodes();
     if (n == 0 || fine_begin.size() != n + 1 || coarse_begin.size() != n + 1
-        || error.size() != n || ball.size() != n || creator.size() != tets.size()
+        || error.size() != n || ball.size() != n || own_error.size() != n
+        || own_ball.size() != n || creator.size() != tets.size()
         || destroyer.size() != tets.size() || vertex_node.size() != vertices.size()
         || fine_begin.front() != 0 || fine_begin.back() != tets.size()
         || coarse_begin.front() != 0 || coarse_begin.back() != coarse_list.size())
