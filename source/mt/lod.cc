@@ -21,6 +21,20 @@ namespace lacerta::mt
       , frontier_position(mt.n_nodes(), mesh::invalid_index)
       , check_at(mt.n_nodes(), 0)
   {
+    // The children of each node, once each (a node's fine tetrahedra have about 12
+    // destroyers but 3 distinct ones): evaluate() walks these lists.
+    children_begin.reserve(mt.n_nodes() + 1);
+    children_begin.push_back(0);
+    for (std::uint32_t j = 0; j < mt.n_nodes(); ++j)
+    {
+      for (std::uint32_t t = mt.fine_begin[j]; t < mt.fine_begin[j + 1]; ++t)
+        if (const std::uint32_t c = mt.destroyer[t];
+            c != mesh::invalid_index
+            && std::find(children.begin() + children_begin.back(), children.end(), c)
+                 == children.end())
+          children.push_back(c);
+      children_begin.push_back(static_cast<std::uint32_t>(children.size()));
+    }
     applied[0] = 1;
     for (std::uint32_t t = mt.fine_begin[0]; t < mt.fine_begin[1]; ++t)
       activate(t);
@@ -113,34 +127,29 @@ namespace lacerta::mt
 
 
   bool
-  Lod::known(const std::uint32_t j) const
-  {
-    // Computed in this extraction, or earlier with a slack the focus has not
-    // travelled yet (need_until is reset when the query object changes).
-    return need_stamp[j] == stamp || travel < need_until[j];
-  }
-
-
-  bool
-  Lod::evaluate_own(const std::uint32_t j, const LodQuery &query)
+  Lod::evaluate_own(const std::uint32_t j, const LodQuery &query, double &bound_until)
   {
     need_stamp[j] = stamp;
     // The bounds: neither j nor a descendant can fail where the query allows error[j]
     // over ball[j].
     const auto        &b = mt->ball[j];
     const mesh::Point3 center{{b[0], b[1], b[2]}};
-    need_until[j] = travel + query.focus_slack(center, b[3], mt->error[j]);
+    bound_until   = travel + query.focus_slack(center, b[3], mt->error[j]);
+    need_until[j] = bound_until;
     if (!(mt->error[j] > query.minimum_error(center, b[3])))
     {
       need_value[j] = 0;
       return true;
     }
+    // Past the bound, j is needed if its own fragments fail. If they do not, the
+    // children decide, and the bound no longer matters: j stays unneeded however it
+    // changes as long as its own test and its children's answers do not.
     const auto        &o = mt->own_ball[j];
     const mesh::Point3 own_center{{o[0], o[1], o[2]}};
-    need_until[j] =
-      std::min(need_until[j],
-               travel + query.focus_slack(own_center, o[3], mt->own_error[j]));
+    need_until[j] = travel + query.focus_slack(own_center, o[3], mt->own_error[j]);
     need_value[j] = mt->own_error[j] > query.minimum_error(own_center, o[3]);
+    if (need_value[j])
+      need_until[j] = std::min(need_until[j], bound_until);
     // The root has no coarse fragment: it is always applied, whatever its children.
     return need_value[j] != 0 || j == 0;
   }
@@ -149,53 +158,52 @@ namespace lacerta::mt
   void
   Lod::evaluate(const std::uint32_t j, const LodQuery &query)
   {
-    if (known(j) || evaluate_own(j, query))
+    double bound_until = 0;
+    if (known(j) || evaluate_own(j, query, bound_until))
       return;
     // Depth first over the descendants whose bounds do not rule them out: j is needed
-    // as soon as one child is (and then stays so while that child does and j's bound
-    // allows), otherwise it is not, until the first of its own tests and its
-    // children's answers can change.
+    // as soon as one child is, and then stays so while that child does and j's bound
+    // allows; otherwise it is not, until the first of its own tests and its
+    // children's answers can change (accumulated in need_until).
     auto &stack = evaluation_stack;
     stack.clear();
-    stack.push_back({j, mt->fine_begin[j]});
+    stack.push_back({j, children_begin[j], bound_until});
     while (!stack.empty())
     {
-      auto &[k, t] = stack.back();
-      if (t == mt->fine_begin[k + 1])
+      Visit &visit = stack.back();
+      if (visit.next == children_begin[visit.node + 1])
       {
-        // No child of k is needed: neither is k.
-        const std::uint32_t done = k;
+        // No child of the node is needed: neither is it.
+        const std::uint32_t done = visit.node;
         stack.pop_back();
         if (!stack.empty())
         {
-          const std::uint32_t parent = stack.back().first;
+          const std::uint32_t parent = stack.back().node;
           need_until[parent]         = std::min(need_until[parent], need_until[done]);
         }
         continue;
       }
-      const std::uint32_t c = mt->destroyer[t++];
-      if (c == mesh::invalid_index)
-        continue;
-      if (!known(c) && !evaluate_own(c, query))
+      const std::uint32_t c = children[visit.next++];
+      if (!known(c) && !evaluate_own(c, query, bound_until))
       {
-        stack.push_back({c, mt->fine_begin[c]});
+        stack.push_back({c, children_begin[c], bound_until});
         continue;
       }
       if (need_value[c] == 0)
       {
-        need_until[k] = std::min(need_until[k], need_until[c]);
+        need_until[visit.node] = std::min(need_until[visit.node], need_until[c]);
         continue;
       }
-      // c is needed: so are k and every node on the stack, for as long as c is and
-      // their bounds allow (the bounds' limits are already in their need_until).
+      // c is needed: so is every node on the stack, for as long as c is and their
+      // bounds allow.
       double until = need_until[c];
       while (!stack.empty())
       {
-        const std::uint32_t a = stack.back().first;
+        const Visit &a     = stack.back();
+        until              = std::min(until, a.bound_until);
+        need_value[a.node] = 1;
+        need_until[a.node] = until;
         stack.pop_back();
-        need_value[a] = 1;
-        until         = std::min(until, need_until[a]);
-        need_until[a] = until;
       }
     }
   }

@@ -114,9 +114,14 @@ namespace lacerta::mt
     bool
     needs(std::uint32_t j, const LodQuery &query);
 
-    /// Whether the answer of needs() for node @p j is known and still valid.
+    /// Whether the answer of needs() for node @p j is known and still valid:
+    /// computed in this extraction, or earlier with a slack the focus has not
+    /// travelled yet (need_until is reset when the query object changes).
     bool
-    known(std::uint32_t j) const;
+    known(const std::uint32_t j) const
+    {
+      return need_stamp[j] == stamp || travel < need_until[j];
+    }
 
     /// Computes needs() for node @p j and the descendants it depends on, with the
     /// travel of the focus up to which each answer holds.
@@ -126,10 +131,11 @@ namespace lacerta::mt
     /**
      * Starts the evaluation of node @p j from its own tests: returns true when they
      * decide (then need_value and need_until are set), false when its children must
-     * be looked at (need_until holds the bound from its own tests).
+     * be looked at (need_until holds the bound from its own tests). @p bound_until is
+     * the focus travel up to which the monotone bound of j keeps its answer.
      */
     bool
-    evaluate_own(std::uint32_t j, const LodQuery &query);
+    evaluate_own(std::uint32_t j, const LodQuery &query, double &bound_until);
 
     void
     toggle(std::uint32_t j);
@@ -162,8 +168,20 @@ namespace lacerta::mt
     std::vector<double> need_until;
     /// The focus travel at this extraction.
     double travel = 0;
-    /// Scratch of evaluate(): (node, next fine tet to look at).
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> evaluation_stack;
+    /// The children of node j (the destroyers of its fine tetrahedra, each once):
+    /// children[children_begin[j] .. children_begin[j + 1]).
+    std::vector<std::uint32_t> children_begin, children;
+    /// A node whose children evaluate() is looking at.
+    struct Visit
+    {
+      std::uint32_t node;
+      /// Where it is in its list of children.
+      std::uint32_t next;
+      /// Up to which focus travel the node's monotone bound holds.
+      double bound_until;
+    };
+    /// Scratch of evaluate().
+    std::vector<Visit> evaluation_stack;
     /// The frontier nodes, with each node's place in it (invalid_index: not in it).
     std::vector<std::uint32_t> frontier;
     std::vector<std::uint32_t> frontier_position;
