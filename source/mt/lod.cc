@@ -126,30 +126,37 @@ namespace lacerta::mt
   }
 
 
+  double
+  Lod::bound_until(const std::uint32_t j, const LodQuery &query) const
+  {
+    const auto &b = mt->ball[j];
+    return travel + query.focus_slack({{b[0], b[1], b[2]}}, b[3], mt->error[j]);
+  }
+
+
   bool
-  Lod::evaluate_own(const std::uint32_t j, const LodQuery &query, double &bound_until)
+  Lod::evaluate_own(const std::uint32_t j, const LodQuery &query)
   {
     need_stamp[j] = stamp;
     // The bounds: neither j nor a descendant can fail where the query allows error[j]
     // over ball[j].
-    const auto        &b = mt->ball[j];
-    const mesh::Point3 center{{b[0], b[1], b[2]}};
-    bound_until   = travel + query.focus_slack(center, b[3], mt->error[j]);
-    need_until[j] = bound_until;
-    if (!(mt->error[j] > query.minimum_error(center, b[3])))
+    const auto &b = mt->ball[j];
+    if (!(mt->error[j] > query.minimum_error({{b[0], b[1], b[2]}}, b[3])))
     {
       need_value[j] = 0;
+      need_until[j] = bound_until(j, query);
       return true;
     }
     // Past the bound, j is needed if its own fragments fail. If they do not, the
     // children decide, and the bound no longer matters: j stays unneeded however it
-    // changes as long as its own test and its children's answers do not.
+    // changes as long as its own test and its children's answers do not (the bound
+    // is then worked out only if a child turns out needed).
     const auto        &o = mt->own_ball[j];
     const mesh::Point3 own_center{{o[0], o[1], o[2]}};
     need_until[j] = travel + query.focus_slack(own_center, o[3], mt->own_error[j]);
     need_value[j] = mt->own_error[j] > query.minimum_error(own_center, o[3]);
     if (need_value[j])
-      need_until[j] = std::min(need_until[j], bound_until);
+      need_until[j] = std::min(need_until[j], bound_until(j, query));
     // The root has no coarse fragment: it is always applied, whatever its children.
     return need_value[j] != 0 || j == 0;
   }
@@ -158,8 +165,7 @@ namespace lacerta::mt
   void
   Lod::evaluate(const std::uint32_t j, const LodQuery &query)
   {
-    double bound_until = 0;
-    if (known(j) || evaluate_own(j, query, bound_until))
+    if (known(j) || evaluate_own(j, query))
       return;
     // Depth first over the descendants whose bounds do not rule them out: j is needed
     // as soon as one child is, and then stays so while that child does and j's bound
@@ -167,7 +173,7 @@ namespace lacerta::mt
     // children's answers can change (accumulated in need_until).
     auto &stack = evaluation_stack;
     stack.clear();
-    stack.push_back({j, children_begin[j], bound_until});
+    stack.push_back({j, children_begin[j]});
     while (!stack.empty())
     {
       Visit &visit = stack.back();
@@ -184,9 +190,9 @@ namespace lacerta::mt
         continue;
       }
       const std::uint32_t c = children[visit.next++];
-      if (!known(c) && !evaluate_own(c, query, bound_until))
+      if (!known(c) && !evaluate_own(c, query))
       {
-        stack.push_back({c, children_begin[c], bound_until});
+        stack.push_back({c, children_begin[c]});
         continue;
       }
       if (need_value[c] == 0)
@@ -199,11 +205,11 @@ namespace lacerta::mt
       double until = need_until[c];
       while (!stack.empty())
       {
-        const Visit &a     = stack.back();
-        until              = std::min(until, a.bound_until);
-        need_value[a.node] = 1;
-        need_until[a.node] = until;
+        const std::uint32_t a = stack.back().node;
         stack.pop_back();
+        until         = std::min(until, bound_until(a, query));
+        need_value[a] = 1;
+        need_until[a] = until;
       }
     }
   }

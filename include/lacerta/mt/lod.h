@@ -131,11 +131,15 @@ namespace lacerta::mt
     /**
      * Starts the evaluation of node @p j from its own tests: returns true when they
      * decide (then need_value and need_until are set), false when its children must
-     * be looked at (need_until holds the bound from its own tests). @p bound_until is
-     * the focus travel up to which the monotone bound of j keeps its answer.
+     * be looked at (need_until holds the bound from its own test).
      */
     bool
-    evaluate_own(std::uint32_t j, const LodQuery &query, double &bound_until);
+    evaluate_own(std::uint32_t j, const LodQuery &query);
+
+    /// The focus travel up to which the monotone bound of node @p j (error, ball)
+    /// keeps its answer.
+    double
+    bound_until(std::uint32_t j, const LodQuery &query) const;
 
     void
     toggle(std::uint32_t j);
@@ -177,8 +181,6 @@ namespace lacerta::mt
       std::uint32_t node;
       /// Where it is in its list of children.
       std::uint32_t next;
-      /// Up to which focus travel the node's monotone bound holds.
-      double bound_until;
     };
     /// Scratch of evaluate().
     std::vector<Visit> evaluation_stack;
