@@ -371,6 +371,40 @@ namespace lacerta
   }
 
 
+  // A deeper MT (jittered 10^3 box) along a curved path of many small moves: the
+  // answers memoised with the travel they hold to are reused across extractions, and
+  // the result must stay that of an extraction from scratch.
+  TEST(MultiTriangulation, MemoisedAnswersKeepIncrementalEqualToScratchOnADeeperMt)
+  {
+    const mesh::TetMesh input = test_support::distorted_box(10, 0.2, {1, 1, 1});
+    const auto          mt    = mt::build_multi_triangulation(input, {});
+    for (const std::string growth : {"0.2", "0.5"})
+    {
+      auto         query = make_query("focus",
+                              {{"Radius", "0.1"},
+                                       {"Cell size growth", growth},
+                                       {"Cell size near the focus", "0.05"}});
+      mt::Lod      incremental(mt);
+      unsigned int n_changes = 0;
+      for (int k = 0; k < 200; ++k)
+      {
+        query->set_focus({{0.1 + 0.004 * k,
+                           0.5 + 0.2 * std::sin(0.03 * k),
+                           0.5 + 0.1 * std::cos(0.05 * k)}});
+        n_changes += incremental.extract(*query);
+        if (k % 5 != 0)
+          continue;
+        mt::Lod scratch(mt);
+        scratch.extract(*query);
+        for (unsigned int j = 0; j < mt.n_nodes(); ++j)
+          ASSERT_EQ(incremental.is_applied(j), scratch.is_applied(j))
+            << "node " << j << ", move " << k << ", growth " << growth;
+      }
+      EXPECT_GT(n_changes, 100u);
+    }
+  }
+
+
   // The slack of the focus query is a true lower bound: a focus that moves less than it
   // leaves the answer of the query for that ball and error unchanged.
   TEST(MultiTriangulation, FocusSlackIsALowerBound)
