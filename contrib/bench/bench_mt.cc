@@ -237,12 +237,14 @@ namespace lacerta::bench
 
     /**
      * How coarse the LODs of the square_lod slab (20 x 20 x 4 hexahedra x 5, 0.1 x 0.1
-     * x 0.02 m, focus radius 0.015, growth 0.5 at z = 0.02) are, and what the
-     * conservative balls cost: for the MT without and with the scene's locked columns
-     * (x = +-0.05), the root, the LOD at a focus on the edge and in the middle, and the
-     * mesh that balls of each node's own fragments would give (needed nodes by own ball
-     * and own error, closed under parents). The mean ball radius, own and inflated,
-     * shows the cause.
+     * x 0.02 m, focus radius 0.015, growth 0.5 at z = 0.02) are: for the MT without
+     * and with the scene's locked columns (x = +-0.05), the root and, for a focus on
+     * the edge and in the middle, the LOD against two other meshes made from the same
+     * MT by brute force: the one the monotone bounds alone would give (nodes whose
+     * error exceeds the query over their ball, the rule of the first version), and
+     * the least set of nodes closed under parents whose active tetrahedra all satisfy
+     * the query (a failing node is applied only if one of its coarse tetrahedra is
+     * active). The mean ball radius, own and bound, shows the cause of the former.
      */
     int
     run_mt_coarseness(const std::vector<std::string> &)
@@ -266,69 +268,70 @@ namespace lacerta::bench
         const std::string prefix =
           std::string("mt_coarseness.") + (lock ? "locked." : "free.");
         print_figure(prefix + "root_tetrahedra", mt.n_fine(0), "");
-        // Each node's own ball (its two fragments) and own error (mean coarse volume).
-        const unsigned int                 n = mt.n_nodes();
-        std::vector<std::array<double, 4>> own(n);
-        std::vector<double>                own_error(n, 0);
-        double                             sum_own = 0, sum_inflated = 0;
+        const unsigned int n       = mt.n_nodes();
+        double             sum_own = 0, sum_bound = 0;
         for (unsigned int j = 1; j < n; ++j)
         {
-          std::vector<std::uint32_t> tets;
-          for (unsigned int k = mt.coarse_begin[j]; k < mt.coarse_begin[j + 1]; ++k)
-            tets.push_back(mt.coarse_list[k]);
-          const std::size_t n_coarse = tets.size();
-          for (unsigned int t = mt.fine_begin[j]; t < mt.fine_begin[j + 1]; ++t)
-            tets.push_back(t);
-          mesh::Point3 center = {{0, 0, 0}};
-          for (const auto t : tets)
-            for (const auto v : mt.tets[t])
-              for (unsigned int d = 0; d < 3; ++d)
-                center[d] += mt.vertices[v][d] / (4.0 * tets.size());
-          double radius = 0;
-          for (std::size_t i = 0; i < tets.size(); ++i)
-          {
-            const auto &c = mt.tets[tets[i]];
-            for (const auto v : c)
-              radius = std::max(radius,
-                                std::hypot(mt.vertices[v][0] - center[0],
-                                           mt.vertices[v][1] - center[1],
-                                           mt.vertices[v][2] - center[2]));
-            if (i < n_coarse)
-              own_error[j] += mesh::signed_volume(mt.vertices[c[0]],
-                                                  mt.vertices[c[1]],
-                                                  mt.vertices[c[2]],
-                                                  mt.vertices[c[3]])
-                              / n_coarse;
-          }
-          own[j] = {{center[0], center[1], center[2], radius}};
-          sum_own += radius;
-          sum_inflated += mt.ball[j][3];
+          sum_own += mt.own_ball[j][3];
+          sum_bound += mt.ball[j][3];
         }
         print_figure(prefix + "mean_own_ball_radius", sum_own / (n - 1), "m");
-        print_figure(prefix + "mean_ball_radius", sum_inflated / (n - 1), "m");
+        print_figure(prefix + "mean_ball_radius", sum_bound / (n - 1), "m");
+        const auto fails = [&](const double error, const std::array<double, 4> &b) {
+          return error > query->minimum_error({{b[0], b[1], b[2]}}, b[3]);
+        };
+        const auto count_tets = [&](const std::vector<char> &in)
+        {
+          unsigned int n_tets = 0;
+          for (unsigned int t = 0; t < mt.n_tets(); ++t)
+            n_tets += in[mt.creator[t]]
+                      && (mt.destroyer[t] == mesh::invalid_index || !in[mt.destroyer[t]]);
+          return n_tets;
+        };
+        // Adds node j and its ancestors to @p in.
+        const auto close = [&](std::vector<char> &in, const unsigned int j)
+        {
+          std::vector<unsigned int> stack = {j};
+          while (!stack.empty())
+          {
+            const unsigned int k = stack.back();
+            stack.pop_back();
+            if (in[k])
+              continue;
+            in[k] = 1;
+            for (unsigned int i = mt.coarse_begin[k]; i < mt.coarse_begin[k + 1]; ++i)
+              stack.push_back(mt.creator[mt.coarse_list[i]]);
+          }
+        };
         for (const double x : {-0.05, 0.0})
         {
           query->set_focus({{x, 0, 0.02}});
           mt::Lod lod(mt);
           lod.extract(*query);
-          std::vector<char> in(n, 0);
-          in[0] = 1;
+          std::vector<char> by_bounds(n, 0), least(n, 0);
+          by_bounds[0] = 1;
           for (unsigned int j = 1; j < n; ++j)
-            in[j] =
-              own_error[j]
-              > query->minimum_error({{own[j][0], own[j][1], own[j][2]}}, own[j][3]);
-          // Close under parents (parents have smaller ids).
-          for (unsigned int j = n; j-- > 1;)
-            if (in[j])
-              for (unsigned int k = mt.coarse_begin[j]; k < mt.coarse_begin[j + 1]; ++k)
-                in[mt.creator[mt.coarse_list[k]]] = 1;
-          unsigned int n_tets = 0;
-          for (unsigned int t = 0; t < mt.n_tets(); ++t)
-            n_tets += in[mt.creator[t]]
-                      && (mt.destroyer[t] == mesh::invalid_index || !in[mt.destroyer[t]]);
+            by_bounds[j] = fails(mt.error[j], mt.ball[j]);
+          // The least fixed point: apply a failing node with an active coarse
+          // tetrahedron (and its ancestors) until there is none.
+          least[0] = 1;
+          for (bool grew = true; grew;)
+          {
+            grew = false;
+            for (unsigned int j = 1; j < n; ++j)
+              if (!least[j] && fails(mt.own_error[j], mt.own_ball[j]))
+                for (unsigned int i = mt.coarse_begin[j]; i < mt.coarse_begin[j + 1]; ++i)
+                  if (least[mt.creator[mt.coarse_list[i]]])
+                  {
+                    close(least, j);
+                    grew = true;
+                    break;
+                  }
+          }
           const std::string at = prefix + (x < 0 ? "edge_focus." : "middle_focus.");
           print_figure(at + "lod_tetrahedra", lod.active_tets().size(), "");
-          print_figure(at + "own_ball_closure_tetrahedra", n_tets, "");
+          print_figure(at + "by_bounds_tetrahedra", count_tets(by_bounds), "");
+          print_figure(at + "least_tetrahedra", count_tets(least), "");
         }
       }
       return 0;
@@ -336,8 +339,9 @@ namespace lacerta::bench
   } // namespace
 
   LACERTA_REGISTER_BENCHMARK("mt-coarseness",
-                             "How coarse the slab's LODs are, against the mesh that "
-                             "balls of each node's own fragments would give",
+                             "How coarse the slab's LODs are, against the meshes of "
+                             "the monotone bounds alone and the least one whose "
+                             "tetrahedra all satisfy the query",
                              run_mt_coarseness);
   LACERTA_REGISTER_BENCHMARK("mt",
                              "MT build time and memory, extraction from scratch and "

@@ -166,6 +166,7 @@ namespace lacerta::mt
                       position.size(),
                       " vertices; the builder handles fewer than 2^21.");
         mark.assign(position.size() + 1, 0);
+        known_errors.resize(position.size());
         for (std::uint32_t t = 0; t < tets.size(); ++t)
           for (const unsigned int v : tets[t])
             star[v].push_back(t);
@@ -204,14 +205,24 @@ namespace lacerta::mt
           const std::uint32_t v = entry.vertex;
           if (removed[v] || entry.stamp != stamp[v])
             continue;
+          if (!entry.exact)
+          {
+            make_exact(entry);
+            continue;
+          }
           const Collapse best = find_collapse(v, true);
           if (best.target == none)
             continue;
-          if (best.priority > entry.priority * (1 + 1e-12) && !queue.empty()
-              && best.priority > queue.top().priority)
+          if (best.priority > entry.priority * (1 + 1e-12))
           {
-            queue.push({best.priority, v, ++stamp[v]});
-            continue;
+            // Compared with the next live entry, made exact: a stale one says nothing
+            // about the mesh as it is, a lower bound too little.
+            settle_top();
+            if (!queue.empty() && best.priority > queue.top().priority)
+            {
+              queue.push({best.priority, v, ++stamp[v], true});
+              continue;
+            }
           }
           collapse(v, best.target);
         }
@@ -221,11 +232,16 @@ namespace lacerta::mt
       assemble() const;
 
     private:
+      /**
+       * A queue entry: the priority of a vertex when its neighbourhood had the given
+       * stamp, exact or (for a boundary vertex not evaluated yet) a lower bound.
+       */
       struct Entry
       {
         double        priority;
         std::uint32_t vertex;
         std::uint32_t stamp;
+        bool          exact;
         bool
         operator<(const Entry &other) const
         {
@@ -235,6 +251,37 @@ namespace lacerta::mt
                  || (priority == other.priority && vertex > other.vertex);
         }
       };
+
+      /**
+       * Replaces the lower bound @p entry (just popped) by the exact priority, or by
+       * nothing if its vertex has no valid collapse. The vertex's neighbourhood is the
+       * one it was queued with, so the order in which exact entries leave the queue
+       * is that of a queue of exact priorities; only the boundary vertices that reach
+       * the top before their neighbourhood changes pay for the Hausdorff test.
+       */
+      void
+      make_exact(const Entry &entry)
+      {
+        const Collapse c = find_collapse(entry.vertex, false);
+        if (c.target != none)
+          queue.push({c.priority, entry.vertex, entry.stamp, true});
+      }
+
+      /// Pops the stale entries at the top of the queue and makes the lower bounds
+      /// there exact, until the top is a live exact entry (or the queue is empty).
+      void
+      settle_top()
+      {
+        while (!queue.empty())
+        {
+          const Entry top = queue.top();
+          if (!removed[top.vertex] && top.stamp == stamp[top.vertex] && top.exact)
+            return;
+          queue.pop();
+          if (!removed[top.vertex] && top.stamp == stamp[top.vertex])
+            make_exact(top);
+        }
+      }
 
       /**
        * Outward oriented boundary faces around @p v, from its star, in @p result
@@ -466,13 +513,16 @@ namespace lacerta::mt
        * after collapsing v onto @p w; infinite if a face would turn over or the
        * distance exceeds @p give_up (then the exact value does not matter).
        * @p faces are v's boundary faces, given to prepare_boundary_error() before.
+       * @p forbidden tells an infinite result that holds whatever @p give_up.
        */
       double
       boundary_error(const std::uint32_t                              v,
                      const std::uint32_t                              w,
                      const std::vector<std::array<std::uint32_t, 3>> &faces,
-                     const double                                     give_up) const
+                     const double                                     give_up,
+                     bool                                            &forbidden) const
       {
+        forbidden   = true;
         auto &after = moved_faces;
         after.clear();
         // Per face of v, its moved face in after (none: it disappears).
@@ -494,6 +544,7 @@ namespace lacerta::mt
         }
         if (after.empty())
           return std::numeric_limits<double>::infinity();
+        forbidden = false;
         // The distance of a sample only matters if it raises the maximum so far: the
         // search over faces stops at the first face closer than that. A sample is
         // usually nearest to the moved version of the face it is attached to, so that
@@ -526,6 +577,42 @@ namespace lacerta::mt
       }
 
       /**
+       * boundary_error(), from what an earlier evaluation of @p v in the same
+       * neighbourhood found out about @p w when that is enough: the exact error, or
+       * that it exceeds a bound at least @p give_up. A vertex is evaluated when it
+       * reaches the top of the queue and again in full when its exact entry does; the
+       * second time costs no distance.
+       */
+      double
+      known_boundary_error(const std::uint32_t                              v,
+                           const std::uint32_t                              w,
+                           const std::vector<std::array<std::uint32_t, 3>> &faces,
+                           const double                                     give_up) const
+      {
+        auto &known = known_errors[v];
+        auto  found = std::find_if(known.begin(),
+                                  known.end(),
+                                  [w](const KnownError &k) { return k.target == w; });
+        if (found != known.end())
+        {
+          if (std::isfinite(found->error))
+            return found->error <= give_up ? found->error
+                                           : std::numeric_limits<double>::infinity();
+          if (give_up <= found->above)
+            return std::numeric_limits<double>::infinity();
+        }
+        bool             forbidden = false;
+        const double     error     = boundary_error(v, w, faces, give_up, forbidden);
+        const KnownError k         = {
+                  w, error, forbidden ? std::numeric_limits<double>::infinity() : give_up};
+        if (found != known.end())
+          *found = k;
+        else
+          known.push_back(k);
+        return error;
+      }
+
+      /**
        * The best valid collapse of @p v and its priority. With @p full, every check is
        * made; without, only the boundary error (for the priority of a queue entry).
        */
@@ -535,13 +622,7 @@ namespace lacerta::mt
         Collapse best;
         if (locked[v] || removed[v] || star[v].empty())
           return best;
-        double volume = 0;
-        for (const std::uint32_t t : star[v])
-          volume += mesh::signed_volume(position[tets[t][0]],
-                                        position[tets[t][1]],
-                                        position[tets[t][2]],
-                                        position[tets[t][3]]);
-        volume /= star[v].size();
+        const double volume = mean_volume(v);
         // The priority of an interior vertex is its volume whatever the target: a queue
         // entry needs no candidate list.
         if (!boundary[v] && !full)
@@ -579,7 +660,7 @@ namespace lacerta::mt
             const double worst = std::isfinite(best.priority)
                                    ? std::min(max_distance, best.error)
                                    : max_distance;
-            error              = boundary_error(v, w, faces, worst);
+            error              = known_boundary_error(v, w, faces, worst);
             if (!(error <= max_distance))
               continue;
           }
@@ -624,13 +705,40 @@ namespace lacerta::mt
         return best;
       }
 
+      /// Mean volume of the tetrahedra around @p v.
+      double
+      mean_volume(const std::uint32_t v) const
+      {
+        double volume = 0;
+        for (const std::uint32_t t : star[v])
+          volume += mesh::signed_volume(position[tets[t][0]],
+                                        position[tets[t][1]],
+                                        position[tets[t][2]],
+                                        position[tets[t][3]]);
+        return volume / star[v].size();
+      }
+
+      /**
+       * Queues @p v after its neighbourhood changed. A boundary vertex goes in with
+       * the lower bound of its priority (its mean volume: the boundary error only
+       * raises it), made exact if it reaches the top of the queue before it changes
+       * again (most are queued many times over before that).
+       */
       void
       schedule(const std::uint32_t v)
       {
         ++stamp[v];
+        known_errors[v].clear();
+        if (locked[v] || removed[v] || star[v].empty())
+          return;
+        if (boundary[v])
+        {
+          queue.push({mean_volume(v), v, stamp[v], false});
+          return;
+        }
         const Collapse c = find_collapse(v, false);
         if (c.target != none)
-          queue.push({c.priority, v, stamp[v]});
+          queue.push({c.priority, v, stamp[v], true});
       }
 
       void
@@ -735,6 +843,16 @@ namespace lacerta::mt
       std::uint32_t                           ghost;
       double                                  max_distance = 0;
       std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> face_points;
+      /// What boundary_error() found for a target: the exact error, or (infinite
+      /// error) that it exceeds @p above (infinite: the collapse is never allowed).
+      struct KnownError
+      {
+        std::uint32_t target;
+        double        error;
+        double        above;
+      };
+      // Per vertex, valid until its neighbourhood changes (schedule() clears it).
+      mutable std::vector<std::vector<KnownError>> known_errors;
       // Scratch of the candidate evaluation, reused so that the search allocates
       // nothing once the buffers have grown (mutable: the evaluation is logically const).
       mutable std::vector<std::uint32_t> mark;
@@ -820,6 +938,8 @@ namespace lacerta::mt
       // Errors and balls, children (earlier collapses, larger node ids) first.
       mt.error.assign(n_nodes, 0);
       mt.ball.assign(n_nodes, {{0, 0, 0, 0}});
+      mt.own_error.assign(n_nodes, 0);
+      mt.own_ball.assign(n_nodes, {{0, 0, 0, 0}});
       const auto volume = [&](const std::uint32_t t)
       {
         const Tet &c = mt.tets[t];
@@ -849,7 +969,9 @@ namespace lacerta::mt
         double radius = 0;
         for (const std::uint32_t p : points)
           radius = std::max(radius, distance(center, position[p]));
-        double error = mt.n_coarse(j) > 0 ? sum / mt.n_coarse(j) : 0;
+        double error    = mt.n_coarse(j) > 0 ? sum / mt.n_coarse(j) : 0;
+        mt.own_error[j] = error;
+        mt.own_ball[j]  = {{center[0], center[1], center[2], radius * (1 + 1e-12)}};
         for (std::uint32_t t = mt.fine_begin[j]; t < mt.fine_begin[j + 1]; ++t)
           if (const std::uint32_t c = mt.destroyer[t]; c != none)
           {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 
 namespace lacerta::mt
 {
@@ -16,9 +17,29 @@ namespace lacerta::mt
       , active_fine(mt.n_nodes(), 0)
       , need_stamp(mt.n_nodes(), 0)
       , need_value(mt.n_nodes(), 0)
+      , need_until(mt.n_nodes(), -std::numeric_limits<double>::infinity())
       , frontier_position(mt.n_nodes(), mesh::invalid_index)
       , check_at(mt.n_nodes(), 0)
   {
+    // The children of each node, once each (a node's fine tetrahedra have about 12
+    // destroyers but 3 distinct ones): evaluate() walks these lists.
+    children_begin.reserve(mt.n_nodes() + 1);
+    children_begin.push_back(0);
+    for (std::uint32_t j = 0; j < mt.n_nodes(); ++j)
+    {
+      mt.for_each_fine(j,
+                       [this](const std::uint32_t t)
+                       {
+                         if (const std::uint32_t c = this->mt->destroyer[t];
+                             c != mesh::invalid_index
+                             && std::find(children.begin() + children_begin.back(),
+                                          children.end(),
+                                          c)
+                                  == children.end())
+                           children.push_back(c);
+                       });
+      children_begin.push_back(static_cast<std::uint32_t>(children.size()));
+    }
     applied[0] = 1;
     mt.for_each_fine(0, [this](const std::uint32_t t) { activate(t); });
   }
@@ -103,9 +124,8 @@ namespace lacerta::mt
   void
   Lod::schedule_check(const std::uint32_t j, const LodQuery &query)
   {
-    const auto  &b     = mt->ball[j];
-    const double slack = query.focus_slack({{b[0], b[1], b[2]}}, b[3], mt->error[j]);
-    check_at[j]        = query.focus_travel() + slack;
+    evaluate(j, query);
+    check_at[j] = need_until[j];
     if (std::isfinite(check_at[j]))
     {
       checks.push_back({check_at[j], j});
@@ -117,13 +137,97 @@ namespace lacerta::mt
   bool
   Lod::needs(const std::uint32_t j, const LodQuery &query)
   {
-    if (need_stamp[j] != stamp)
-    {
-      const auto &b = mt->ball[j];
-      need_stamp[j] = stamp;
-      need_value[j] = mt->error[j] > query.minimum_error({{b[0], b[1], b[2]}}, b[3]);
-    }
+    evaluate(j, query);
     return need_value[j] != 0;
+  }
+
+
+  double
+  Lod::bound_until(const std::uint32_t j, const LodQuery &query) const
+  {
+    const auto &b = mt->ball[j];
+    return travel + query.focus_slack({{b[0], b[1], b[2]}}, b[3], mt->error[j]);
+  }
+
+
+  bool
+  Lod::evaluate_own(const std::uint32_t j, const LodQuery &query)
+  {
+    need_stamp[j] = stamp;
+    // The bounds: neither j nor a descendant can fail where the query allows error[j]
+    // over ball[j].
+    const auto &b = mt->ball[j];
+    if (!(mt->error[j] > query.minimum_error({{b[0], b[1], b[2]}}, b[3])))
+    {
+      need_value[j] = 0;
+      need_until[j] = bound_until(j, query);
+      return true;
+    }
+    // Past the bound, j is needed if its own fragments fail. If they do not, the
+    // children decide, and the bound no longer matters: j stays unneeded however it
+    // changes as long as its own test and its children's answers do not (the bound
+    // is then worked out only if a child turns out needed).
+    const auto        &o = mt->own_ball[j];
+    const mesh::Point3 own_center{{o[0], o[1], o[2]}};
+    need_until[j] = travel + query.focus_slack(own_center, o[3], mt->own_error[j]);
+    need_value[j] = mt->own_error[j] > query.minimum_error(own_center, o[3]);
+    if (need_value[j])
+      need_until[j] = std::min(need_until[j], bound_until(j, query));
+    // The root has no coarse fragment: it is always applied, whatever its children.
+    return need_value[j] != 0 || j == 0;
+  }
+
+
+  void
+  Lod::evaluate(const std::uint32_t j, const LodQuery &query)
+  {
+    if (known(j) || evaluate_own(j, query))
+      return;
+    // Depth first over the descendants whose bounds do not rule them out: j is needed
+    // as soon as one child is, and then stays so while that child does and j's bound
+    // allows; otherwise it is not, until the first of its own tests and its
+    // children's answers can change (accumulated in need_until).
+    auto &stack = evaluation_stack;
+    stack.clear();
+    stack.push_back({j, children_begin[j]});
+    while (!stack.empty())
+    {
+      Visit &visit = stack.back();
+      if (visit.next == children_begin[visit.node + 1])
+      {
+        // No child of the node is needed: neither is it.
+        const std::uint32_t done = visit.node;
+        stack.pop_back();
+        if (!stack.empty())
+        {
+          const std::uint32_t parent = stack.back().node;
+          need_until[parent]         = std::min(need_until[parent], need_until[done]);
+        }
+        continue;
+      }
+      const std::uint32_t c = children[visit.next++];
+      if (!known(c) && !evaluate_own(c, query))
+      {
+        stack.push_back({c, children_begin[c]});
+        continue;
+      }
+      if (need_value[c] == 0)
+      {
+        need_until[visit.node] = std::min(need_until[visit.node], need_until[c]);
+        continue;
+      }
+      // c is needed: so is every node on the stack, for as long as c is and their
+      // bounds allow.
+      double until = need_until[c];
+      while (!stack.empty())
+      {
+        const std::uint32_t a = stack.back().node;
+        stack.pop_back();
+        until         = std::min(until, bound_until(a, query));
+        need_value[a] = 1;
+        need_until[a] = until;
+      }
+    }
   }
 
 
@@ -164,11 +268,14 @@ namespace lacerta::mt
     // otherwise those that joined the frontier since their last test and those whose
     // slack the focus has travelled past (the others keep their need: they stay).
     std::vector<std::uint32_t> candidates;
-    const double               travel = query.focus_travel();
+    travel = query.focus_travel();
     if (query.identity() != query_identity)
     {
       query_identity = query.identity();
-      candidates     = frontier;
+      std::fill(need_until.begin(),
+                need_until.end(),
+                -std::numeric_limits<double>::infinity());
+      candidates = frontier;
       checks.clear();
     }
     else

@@ -4,12 +4,37 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace lacerta::mt
 {
   namespace
   {
+    /**
+     * The cube root of @p x to a few units in the last place: a first guess from the
+     * exponent bits, refined by Newton steps. focus_slack() needs one for every node
+     * an incremental extraction tests, and std::cbrt costs several times more.
+     */
+    double
+    cube_root(const double x)
+    {
+      if (!(x >= std::numeric_limits<double>::min()) || !std::isfinite(x))
+        return std::cbrt(x); // zero, subnormal, negative, infinite or NaN
+      std::uint64_t bits = 0;
+      std::memcpy(&bits, &x, sizeof(x));
+      // Divides the biased exponent by 3: within 4 % of the root.
+      bits     = bits / 3 + 0x2a9f789300000000ull;
+      double y = 0;
+      std::memcpy(&y, &bits, sizeof(y));
+      // Newton converges quadratically: 4 % -> 1e-3 -> 1e-6 -> 1e-12 -> rounding.
+      for (unsigned int i = 0; i < 4; ++i)
+        y -= (y * y * y - x) / (3 * y * y);
+      return y;
+    }
+
+
     /**
      * The same cell size everywhere.
      */
@@ -109,7 +134,7 @@ namespace lacerta::mt
         // radius + (h - h0) / growth, h the cell size of the error: the focus must
         // travel at least |distance - D| to change it. The margin covers rounding (h
         // from the error by a cube root).
-        const double h = std::cbrt(error * 6 * std::sqrt(2.0));
+        const double h = cube_root(error * 6 * std::sqrt(2.0));
         if (growth == 0 || h < near_size * (1 - 1e-9))
           return std::numeric_limits<double>::infinity(); // never changes
         if (h <= near_size)

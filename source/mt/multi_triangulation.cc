@@ -12,8 +12,9 @@ namespace lacerta::mt
               + coarse_begin.capacity() + coarse_list.capacity() + node_vertex.capacity()
               + vertex_node.capacity())
                * sizeof(std::uint32_t)
-           + replaced.capacity() + error.capacity() * sizeof(double)
-           + ball.capacity() * sizeof(std::array<double, 4>);
+           + replaced.capacity()
+           + (error.capacity() + own_error.capacity()) * sizeof(double)
+           + (ball.capacity() + own_ball.capacity()) * sizeof(std::array<double, 4>);
   }
 
 
@@ -35,7 +36,8 @@ namespace lacerta::mt
   {
     const std::size_t n = n_nodes();
     if (n == 0 || fine_begin.size() != n + 1 || coarse_begin.size() != n + 1
-        || error.size() != n || ball.size() != n || creator.size() != tets.size()
+        || error.size() != n || ball.size() != n || own_error.size() != n
+        || own_ball.size() != n || creator.size() != tets.size()
         || destroyer.size() != tets.size() || vertex_node.size() != vertices.size()
         || fine_begin.front() != 0
         // Tets beyond the decimation's ranges are children a cut appended.

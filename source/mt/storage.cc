@@ -52,6 +52,8 @@ namespace lacerta::mt
       f(mt.vertex_node);
       f(mt.error);
       f(mt.ball);
+      f(mt.own_error);
+      f(mt.own_ball);
     }
   } // namespace
 

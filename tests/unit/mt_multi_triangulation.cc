@@ -169,13 +169,13 @@ namespace lacerta
       lod.extract(*query);
       const mesh::TetMesh active = lod.make_mesh(lod.active_vertices(), "lod");
       // Every active tetrahedron satisfies the query: the node that would refine it
-      // does not need applying.
+      // does not fail it.
       for (const auto t : lod.active_tets())
       {
         if (const auto d = mt.destroyer[t]; d != mesh::invalid_index)
         {
-          const auto &b = mt.ball[d];
-          EXPECT_LE(mt.error[d], query->minimum_error({{b[0], b[1], b[2]}}, b[3]));
+          const auto &b = mt.own_ball[d];
+          EXPECT_LE(mt.own_error[d], query->minimum_error({{b[0], b[1], b[2]}}, b[3]));
         }
       }
       expect_conforming_box(active);
@@ -183,6 +183,50 @@ namespace lacerta
       const auto masses = physics::compute_masses(active, density);
       EXPECT_NEAR(std::accumulate(masses.begin(), masses.end(), 0.0), 1000.0, 1e-9);
     }
+  }
+
+
+  // The LOD is the smallest closed set that refines every fragment failing the query:
+  // the nodes failing by their own error and ball, closed under parents, found here by
+  // brute force over all nodes. The monotone bounds (error, ball) only cut the search.
+  TEST(MultiTriangulation, LodIsTheClosureOfTheFailingNodes)
+  {
+    const auto  &mt       = box_mt();
+    unsigned int n_closed = 0, n_bound = 0;
+    for (const std::string growth : {"0.2", "0.5", "2"})
+    {
+      auto query = make_query("focus", {{"Radius", "0.1"}, {"Cell size growth", growth}});
+      for (const Point3 &focus : {Point3{{0.1, 0.5, 0.5}}, Point3{{0.5, 0.5, 1.0}}})
+      {
+        query->set_focus(focus);
+        mt::Lod lod(mt);
+        lod.extract(*query);
+        std::vector<char> in(mt.n_nodes(), 0), bound(mt.n_nodes(), 0);
+        in[0] = bound[0] = 1;
+        for (unsigned int j = 1; j < mt.n_nodes(); ++j)
+        {
+          const auto &o = mt.own_ball[j];
+          in[j] = mt.own_error[j] > query->minimum_error({{o[0], o[1], o[2]}}, o[3]);
+          const auto &b = mt.ball[j];
+          bound[j]      = mt.error[j] > query->minimum_error({{b[0], b[1], b[2]}}, b[3]);
+        }
+        // Children have larger ids than their parents.
+        for (unsigned int j = mt.n_nodes(); j-- > 1;)
+          if (in[j])
+            for (unsigned int k = mt.coarse_begin[j]; k < mt.coarse_begin[j + 1]; ++k)
+              in[mt.creator[mt.coarse_list[k]]] = 1;
+        for (unsigned int j = 0; j < mt.n_nodes(); ++j)
+        {
+          ASSERT_EQ(lod.is_applied(j), in[j] != 0) << "node " << j;
+          // The bounds are conservative: every applied node passes them.
+          EXPECT_TRUE(!in[j] || bound[j]) << "node " << j;
+          n_closed += in[j];
+          n_bound += bound[j];
+        }
+      }
+    }
+    // The own balls make a difference here (the bounds alone would apply more).
+    EXPECT_LT(n_closed, n_bound);
   }
 
 
@@ -312,6 +356,40 @@ namespace lacerta
       mt::Lod scratch(mt);
       scratch.extract(*uniform);
       ASSERT_EQ(active_set(mt, incremental), active_set(mt, scratch));
+    }
+  }
+
+
+  // A deeper MT (jittered 10^3 box) along a curved path of many small moves: the
+  // answers memoised with the travel they hold to are reused across extractions, and
+  // the result must stay that of an extraction from scratch.
+  TEST(MultiTriangulation, MemoisedAnswersKeepIncrementalEqualToScratchOnADeeperMt)
+  {
+    const mesh::TetMesh input = test_support::distorted_box(10, 0.2, {1, 1, 1});
+    const auto          mt    = mt::build_multi_triangulation(input, {});
+    for (const std::string growth : {"0.2", "0.5"})
+    {
+      auto         query = make_query("focus",
+                              {{"Radius", "0.1"},
+                                       {"Cell size growth", growth},
+                                       {"Cell size near the focus", "0.05"}});
+      mt::Lod      incremental(mt);
+      unsigned int n_changes = 0;
+      for (int k = 0; k < 200; ++k)
+      {
+        query->set_focus({{0.1 + 0.004 * k,
+                           0.5 + 0.2 * std::sin(0.03 * k),
+                           0.5 + 0.1 * std::cos(0.05 * k)}});
+        n_changes += incremental.extract(*query);
+        if (k % 5 != 0)
+          continue;
+        mt::Lod scratch(mt);
+        scratch.extract(*query);
+        for (unsigned int j = 0; j < mt.n_nodes(); ++j)
+          ASSERT_EQ(incremental.is_applied(j), scratch.is_applied(j))
+            << "node " << j << ", move " << k << ", growth " << growth;
+      }
+      EXPECT_GT(n_changes, 100u);
     }
   }
 

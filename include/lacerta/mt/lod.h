@@ -20,13 +20,15 @@ namespace lacerta::mt
    * The current level of detail: the set of applied nodes (closed under parents) and
    * the tetrahedra it selects.
    *
-   * Node j must be applied when its error exceeds the smallest error the query allows
-   * over its ball. Errors never decrease and balls never shrink from a node to its
-   * parents, so this predicate is monotone along the DAG; the applied set is then
-   * exactly the nodes that satisfy it, the smallest closed set whose tetrahedra all
-   * satisfy the query, i.e. the conforming mesh with the fewest tetrahedra. The same
-   * set comes out whether it is extracted from the root or updated from any previous
-   * level of detail.
+   * A node *fails* the query when its own error exceeds the smallest error the query
+   * allows over its own ball (MultiTriangulation::own_error, own_ball): its coarse
+   * tetrahedra are too coarse there. Node j must be applied when it or one of its
+   * descendants fails; this predicate is closed under parents, so the applied set is
+   * exactly the nodes that satisfy it: the smallest set closed under parents that
+   * contains every failing node, the conforming mesh with the fewest tetrahedra that
+   * refines every failing fragment. The same set comes out whether it is extracted
+   * from the root or updated from any previous level of detail. The search of the
+   * descendants is cut short by the monotone bounds (error, ball) of the MT.
    */
   class Lod
   {
@@ -119,6 +121,33 @@ namespace lacerta::mt
     bool
     needs(std::uint32_t j, const LodQuery &query);
 
+    /// Whether the answer of needs() for node @p j is known and still valid:
+    /// computed in this extraction, or earlier with a slack the focus has not
+    /// travelled yet (need_until is reset when the query object changes).
+    bool
+    known(const std::uint32_t j) const
+    {
+      return need_stamp[j] == stamp || travel < need_until[j];
+    }
+
+    /// Computes needs() for node @p j and the descendants it depends on, with the
+    /// travel of the focus up to which each answer holds.
+    void
+    evaluate(std::uint32_t j, const LodQuery &query);
+
+    /**
+     * Starts the evaluation of node @p j from its own tests: returns true when they
+     * decide (then need_value and need_until are set), false when its children must
+     * be looked at (need_until holds the bound from its own test).
+     */
+    bool
+    evaluate_own(std::uint32_t j, const LodQuery &query);
+
+    /// The focus travel up to which the monotone bound of node @p j (error, ball)
+    /// keeps its answer.
+    double
+    bound_until(std::uint32_t j, const LodQuery &query) const;
+
     void
     toggle(std::uint32_t j);
 
@@ -146,6 +175,22 @@ namespace lacerta::mt
     std::vector<std::uint32_t> active_fine;
     std::vector<std::uint32_t> need_stamp;
     std::vector<std::uint8_t>  need_value;
+    /// Per node: the focus travel up to which need_value holds (see known()).
+    std::vector<double> need_until;
+    /// The focus travel at this extraction.
+    double travel = 0;
+    /// The children of node j (the destroyers of its fine tetrahedra, each once):
+    /// children[children_begin[j] .. children_begin[j + 1]).
+    std::vector<std::uint32_t> children_begin, children;
+    /// A node whose children evaluate() is looking at.
+    struct Visit
+    {
+      std::uint32_t node;
+      /// Where it is in its list of children.
+      std::uint32_t next;
+    };
+    /// Scratch of evaluate().
+    std::vector<Visit> evaluation_stack;
     /// The frontier nodes, with each node's place in it (invalid_index: not in it).
     std::vector<std::uint32_t> frontier;
     std::vector<std::uint32_t> frontier_position;

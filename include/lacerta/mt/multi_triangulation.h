@@ -55,7 +55,8 @@ namespace lacerta::mt
     /**
      * Per node: its error, the average volume of its coarse fragment (Section 4.1),
      * raised to the largest error of its descendants so that it never decreases from
-     * a node to its parents.
+     * a node to its parents. With ball, a bound for the node and all its descendants:
+     * where the query allows this error over this ball, no descendant needs applying.
      */
     std::vector<double> error;
     /**
@@ -80,6 +81,15 @@ namespace lacerta::mt
      * previous level's tet around it from there). Empty until the first cut.
      */
     std::vector<std::uint32_t> cut_origin;
+    /**
+     * Per node: its own error, the average volume of its coarse fragment alone (0 for
+     * the root). A tetrahedron satisfies a query when the node that removes it has an
+     * own error within what the query allows over that node's own ball.
+     */
+    std::vector<double> own_error;
+    /// Per node: a ball (x, y, z, radius) that contains its two fragments; the center
+    /// is that of ball, so that own_ball lies inside ball.
+    std::vector<std::array<double, 4>> own_ball;
 
     /// Number of nodes (the root included).
     unsigned int

@@ -17,7 +17,7 @@
 namespace lacerta::mt
 {
   /// Version of the file format; a file of another version is stale.
-  constexpr std::uint32_t file_format_version = 1;
+  constexpr std::uint32_t file_format_version = 2;
 
   /**
    * A 64-bit hash (FNV-1a) of everything the MT depends on: the mesh's vertices and
