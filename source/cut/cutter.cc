@@ -520,11 +520,11 @@ namespace lacerta::cut
     // not behind the start of this sweep by more than a cell (the plane must not
     // reach back along an older part of the crack), or when an earlier sweep of the
     // stroke swept it.
-    s.reached     = on_surface[v]
-                      ? surface.behind(x) < 0
-                      : (surface.behind(x) < 0 && surface.ahead_of_start(x) >= -start_reach)
+    s.reached = on_surface[v]
+                  ? surface.behind(x) < 0
+                  : (surface.behind(x) < 0 && surface.ahead_of_start(x) >= -start_reach)
                       || swept[v] == stroke;
-    s.group_stamp = 0;
+    s.parent  = v;
     return s;
   }
 
@@ -576,42 +576,69 @@ namespace lacerta::cut
       // beyond the affected cells through the vertex stars, waits until all of it
       // has been swept. Its vertices outside the affected set join it when reached.
       group_extra.clear();
-      for (const unsigned int v0 : verts)
+      const auto root = [&](unsigned int v)
       {
-        if (!vertex_scratch[v0].on_plane
-            || vertex_scratch[v0].group_stamp == analysis_stamp)
-          continue;
-        group.clear();
-        group.push_back(v0);
-        vertex_scratch[v0].group_stamp = analysis_stamp;
-        bool all_reached               = true;
-        for (std::size_t q = 0; q < group.size(); ++q)
+        while (vertex_scratch[v].parent != v)
+          v = vertex_scratch[v].parent = vertex_scratch[vertex_scratch[v].parent].parent;
+        return v;
+      };
+      // Inside the affected cells: the edges in the surface.
+      for (const unsigned int e : edge_list)
+        if (vertex_scratch[edges[e][0]].on_plane && vertex_scratch[edges[e][1]].on_plane)
+          vertex_scratch[root(edges[e][0])].parent = root(edges[e][1]);
+      // Beyond them, from the fresh vertices on the plane (not yet on the crack: the
+      // crack already made is reached and need not be walked) through their stars.
+      group.clear();
+      for (const unsigned int v : verts)
+        if (vertex_scratch[v].on_plane && !on_surface[v])
+          group.push_back(v);
+      for (std::size_t q = 0; q < group.size(); ++q)
+      {
+        const unsigned int u = group[q];
+        for (const unsigned int t : mesh.tets_of_vertex(u))
         {
-          const unsigned int u = group[q];
-          all_reached          = all_reached && vertex_scratch[u].reached;
-          if (vertex_scratch[u].reached && !on_surface[u])
-            swept[u] = stroke;
-          for (const unsigned int t : mesh.tets_of_vertex(u))
-            for (const unsigned int w : mesh.tet(t))
+          if (tet_mark[t] == affected_stamp)
+            continue;
+          for (const unsigned int w : mesh.tet(t))
+          {
+            if (w == u || on_surface[w])
+              continue;
+            const bool     is_new = vertex_scratch[w].stamp != analysis_stamp;
+            VertexScratch &s      = vertex_data(w, surface);
+            if (!s.on_plane)
+              continue;
+            if (is_new)
             {
-              if (w == u)
-                continue;
-              const bool     is_new = vertex_scratch[w].stamp != analysis_stamp;
-              VertexScratch &s      = vertex_data(w, surface);
-              // Beyond the affected cells the patch follows fresh vertices only: the
-              // crack already made is reached and need not be walked.
-              if (!s.on_plane || s.group_stamp == analysis_stamp
-                  || (is_new && on_surface[w]))
-                continue;
-              s.group_stamp = analysis_stamp;
+              group_extra.push_back(w);
               group.push_back(w);
-              if (is_new)
-                group_extra.push_back(w);
             }
+            vertex_scratch[root(w)].parent = root(u);
+          }
         }
-        for (const unsigned int u : group)
-          vertex_scratch[u].reached = all_reached;
       }
+      for (const unsigned int v : verts)
+        vertex_scratch[v].group_reached = true;
+      for (const unsigned int v : group_extra)
+        vertex_scratch[v].group_reached = true;
+      const auto gather = [&](const unsigned int v)
+      {
+        VertexScratch &s = vertex_scratch[v];
+        if (!s.on_plane)
+          return;
+        if (s.reached && !on_surface[v])
+          swept[v] = stroke;
+        if (!s.reached)
+          vertex_scratch[root(v)].group_reached = false;
+      };
+      for (const unsigned int v : verts)
+        gather(v);
+      for (const unsigned int v : group_extra)
+        gather(v);
+      for (const unsigned int v : verts)
+        if (vertex_scratch[v].on_plane)
+          vertex_scratch[v].reached = vertex_scratch[root(v)].group_reached;
+      for (const unsigned int v : group_extra)
+        vertex_scratch[v].reached = vertex_scratch[root(v)].group_reached;
       for (const unsigned int v : verts)
       {
         VertexScratch &s = vertex_scratch[v];

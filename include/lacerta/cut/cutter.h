@@ -159,9 +159,11 @@ namespace lacerta::cut
     /// Per-vertex scratch of the analysis, valid where `stamp` is the current one.
     struct VertexScratch
     {
-      unsigned int stamp = 0, group_stamp = 0, star_stamp = 0;
+      unsigned int stamp = 0, star_stamp = 0;
+      /// Union-find parent (a vertex id) of the patch of on-plane vertices.
+      unsigned int parent   = 0;
       double       d        = 0;
-      bool         on_plane = false, reached = false;
+      bool         on_plane = false, reached = false, group_reached = false;
       std::int8_t  side = 0;
     };
 
