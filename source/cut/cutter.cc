@@ -8,9 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <map>
 #include <numeric>
-#include <set>
 
 namespace lacerta::cut
 {
@@ -18,36 +16,12 @@ namespace lacerta::cut
   {
     using Clock = std::chrono::steady_clock;
 
-    std::array<unsigned int, 3>
-    sorted3(unsigned int a, unsigned int b, unsigned int c)
-    {
-      std::array<unsigned int, 3> f{{a, b, c}};
-      std::sort(f.begin(), f.end());
-      return f;
-    }
-
-    /// Union-find on small index sets.
-    struct Groups
-    {
-      std::vector<std::size_t> parent;
-      explicit Groups(const std::size_t n)
-          : parent(n)
-      {
-        std::iota(parent.begin(), parent.end(), 0);
-      }
-      std::size_t
-      find(std::size_t i)
-      {
-        while (parent[i] != i)
-          i = parent[i] = parent[parent[i]];
-        return i;
-      }
-      void
-      join(const std::size_t a, const std::size_t b)
-      {
-        parent[find(a)] = find(b);
-      }
-    };
+    /// How far (in typical edges) behind its start line a sweep's plane still cuts
+    /// once the stroke has cut: rounding only. The part behind the last front is cut
+    /// already (by the earlier plane, which differs at a corner of the path). The
+    /// first cut of a stroke that plunged into the tissue reaches back one edge, so
+    /// that the crack does not start inside a cell (the table has one front only).
+    constexpr double start_tolerance = 1e-9;
 
     /// Whether local node @p n of a child lies on local face @p f of its parent.
     bool
@@ -128,6 +102,7 @@ namespace lacerta::cut
     tet_stamp.assign(mesh.n_tets(), 0);
     edge_stamp.assign(mesh.n_edges(), 0);
     on_surface.assign(mesh.n_vertices(), 0);
+    prepare_scratch();
   }
 
 
@@ -146,6 +121,9 @@ namespace lacerta::cut
       if (v < on_surface.size())
         on_surface[v] = 0;
     on_surface_list.clear();
+    // Cells made by partial splits and vertices swept belong to this stroke only.
+    ++stroke;
+    stroke_has_cut = false;
   }
 
 
@@ -322,230 +300,67 @@ namespace lacerta::cut
   Cutter::sweep(const Blade &end, CutStepStatistics &statistics)
   {
     ++statistics.sweeps;
-    const Blade                              &s     = front;
-    const std::array<std::array<Point, 3>, 2> swept = {
+    const Blade                              &s               = front;
+    const std::array<std::array<Point, 3>, 2> swept_triangles = {
       {{{s.tail, s.head, end.tail}}, {{end.tail, s.head, end.head}}}};
-    find_tets_to_cut(swept, end);
+    find_tets_to_cut(swept_triangles, end);
     active.swap(next_active);
     if (candidates.empty())
     {
       // Out of the tissue: the stroke is over.
       front = end;
       end_stroke();
-      n_postponed = 0;
       return;
     }
 
     // The cut surface of this sweep in the deformed configuration: the plane through
     // the last crack front along the motion, and the new crack front.
-    const Point motion =
+    SweepSurface surface;
+    surface.motion =
       sub(scale(0.5, add(end.tail, end.head)), scale(0.5, add(s.tail, s.head)));
-    Point normal = cross(sub(s.head, s.tail), motion);
-    if (!(norm(normal) > 1e-12 * norm(sub(s.head, s.tail)) * norm(motion)))
+    Point normal = cross(sub(s.head, s.tail), surface.motion);
+    if (!(norm(normal) > 1e-12 * norm(sub(s.head, s.tail)) * norm(surface.motion)))
     {
       // The blade moved along itself: it sweeps no surface.
       front = end;
       return;
     }
-    normal                = normalized(normal);
-    const Point origin    = s.tail;
-    Point       front_dir = normalized(cross(normal, sub(end.head, end.tail)));
-    if (dot(front_dir, motion) < 0)
-      front_dir = scale(-1, front_dir);
-    const auto distance = [&](const Point &x) { return dot(normal, sub(x, origin)); };
-    const auto behind = [&](const Point &x) { return dot(front_dir, sub(x, end.tail)); };
-    const double eps  = parameters.snap_fraction;
-    const double zero = 1e-12 * typical_edge;
+    surface.normal    = normalized(normal);
+    surface.origin    = s.tail;
+    surface.end_tail  = end.tail;
+    surface.front_dir = normalized(cross(surface.normal, sub(end.head, end.tail)));
+    if (dot(surface.front_dir, surface.motion) < 0)
+      surface.front_dir = scale(-1, surface.front_dir);
+    // The start line is the last front: in the plane, perpendicular to it, towards
+    // the motion.
+    surface.start_dir = normalized(cross(surface.normal, sub(s.head, s.tail)));
+    if (dot(surface.start_dir, surface.motion) < 0)
+      surface.start_dir = scale(-1, surface.start_dir);
+    const double eps = parameters.snap_fraction;
+    start_reach      = (stroke_has_cut ? start_tolerance : 1.0) * typical_edge;
 
     const auto t_start = Clock::now();
+    const auto spent   = [&]
+    {
+      statistics.update_seconds +=
+        std::chrono::duration<double>(Clock::now() - t_start).count();
+    };
+    prepare_scratch();
     // The affected set: C, closed under the stars of cut edges, front faces and
     // vertices joining the crack (all of which must be split alike).
-    std::vector<unsigned int>                               affected = candidates;
-    std::map<unsigned int, double>                          d;
-    std::map<unsigned int, std::int8_t>                     side;
-    std::map<std::pair<unsigned int, unsigned int>, double> edge_t; // cut edges
-    std::map<std::array<unsigned int, 3>, std::pair<Point, Point>>
-                                 front_points; // rest, deformed
-    std::set<unsigned int>       in_set(affected.begin(), affected.end());
-    std::set<unsigned int>       needs_star;
-    std::map<unsigned int, bool> on_plane_final;
-    bool                         closed = false;
-    for (unsigned int iteration = 0; iteration < 6 && !closed; ++iteration)
-    {
-      d.clear();
-      side.clear();
-      edge_t.clear();
-      front_points.clear();
-      std::set<std::pair<unsigned int, unsigned int>> edges;
-      for (const unsigned int t : affected)
-      {
-        const mesh::Tet &tet = mesh.tet(t);
-        for (const auto &e : tet_edge_vertices)
-          edges.insert({std::min(tet[e[0]], tet[e[1]]), std::max(tet[e[0]], tet[e[1]])});
-        for (const unsigned int v : tet)
-          if (!d.count(v))
-          {
-            double dv = distance(position(v));
-            if (std::abs(dv) <= zero)
-              dv = 0;
-            d[v] = dv;
-          }
-      }
-      // Snapping: a vertex on the surface (exactly, kept from earlier sweeps of the
-      // stroke, or snapped by a crossing close to it) has no cut edge.
-      std::map<unsigned int, bool> on_plane, reached;
-      std::vector<unsigned int>    verts;
-      for (const auto &[v, dv] : d)
-      {
-        verts.push_back(v);
-        const double local = eps * typical_edge;
-        on_plane[v] =
-          dv == 0 || (v < on_surface.size() && on_surface[v] && std::abs(dv) <= local);
-        reached[v] = behind(position(v)) < 0;
-      }
-      for (const auto &[a, b] : edges)
-        if (!on_plane[a] && !on_plane[b] && d[a] * d[b] < 0)
-        {
-          const EdgeSnap snap = snap_edge_parameter(d[a] / (d[a] - d[b]), eps);
-          if (snap == EdgeSnap::first_vertex)
-            on_plane[a] = true;
-          else if (snap == EdgeSnap::second_vertex)
-            on_plane[b] = true;
-        }
-      // Vertices on the surface joined by edges in the surface are reached together.
-      {
-        Groups     groups(verts.size());
-        const auto index = [&](unsigned int v)
-        { return std::lower_bound(verts.begin(), verts.end(), v) - verts.begin(); };
-        for (const auto &[a, b] : edges)
-          if (on_plane[a] && on_plane[b])
-            groups.join(index(a), index(b));
-        std::vector<bool> all(verts.size(), true);
-        for (std::size_t i = 0; i < verts.size(); ++i)
-          if (on_plane[verts[i]] && !reached[verts[i]])
-            all[groups.find(i)] = false;
-        for (std::size_t i = 0; i < verts.size(); ++i)
-          if (on_plane[verts[i]])
-            reached[verts[i]] = all[groups.find(i)];
-      }
-      for (const unsigned int v : verts)
-        side[v] = on_plane[v] && reached[v] ? 0 : (d[v] >= 0 ? 1 : -1);
-      on_plane_final = on_plane;
-      // Crossings of the surface; the reached ones are cut.
-      std::map<std::pair<unsigned int, unsigned int>, bool> crossing_reached;
-      for (const auto &[a, b] : edges)
-        if (!on_plane[a] && !on_plane[b] && d[a] * d[b] < 0)
-        {
-          const double t = d[a] / (d[a] - d[b]);
-          const Point  p = lerp(position(a), position(b), t);
-          // The plane of this sweep reaches back only to its start line (within a
-          // cell): at a corner of the path it must not cut on along the old crack.
-          if (dot(motion, sub(p, origin)) < -typical_edge * norm(motion))
-            continue;
-          const bool r             = behind(p) < 0;
-          crossing_reached[{a, b}] = r;
-          if (r)
-            edge_t[{a, b}] = t;
-        }
-      // Front points, once per face, from the face's two section corners.
-      std::set<std::array<unsigned int, 3>> faces;
-      for (const unsigned int t : affected)
-        for (const auto &fv : mesh::TetMesh::face_vertices)
-          faces.insert(
-            sorted3(mesh.tet(t)[fv[0]], mesh.tet(t)[fv[1]], mesh.tet(t)[fv[2]]));
-      for (const auto &f : faces)
-      {
-        struct Corner
-        {
-          Point rest, now;
-          bool  reached;
-        };
-        std::vector<Corner> corners;
-        unsigned int        vertex_corners = 0;
-        for (unsigned int k = 0; k < 3; ++k)
-          if (on_plane[f[k]])
-          {
-            corners.push_back({mesh.vertex(f[k]), position(f[k]), reached[f[k]]});
-            ++vertex_corners;
-          }
-        for (unsigned int k = 0; k < 3; ++k)
-          for (unsigned int l = k + 1; l < 3; ++l)
-          {
-            const auto it = crossing_reached.find({f[k], f[l]});
-            if (it == crossing_reached.end())
-              continue;
-            const double t = d[f[k]] / (d[f[k]] - d[f[l]]);
-            corners.push_back({lerp(mesh.vertex(f[k]), mesh.vertex(f[l]), t),
-                               lerp(position(f[k]), position(f[l]), t),
-                               it->second});
-          }
-        if (corners.size() != 2 || corners[0].reached == corners[1].reached
-            || vertex_corners == 2)
-          continue;
-        const Corner &r  = corners[0].reached ? corners[0] : corners[1];
-        const Corner &u  = corners[0].reached ? corners[1] : corners[0];
-        const double  pr = behind(r.now), pu = behind(u.now);
-        const double  t = clamp_front_parameter(pr / (pr - pu), eps);
-        front_points[f] = {lerp(r.rest, u.rest, t), lerp(r.now, u.now, t)};
-      }
-      // Closure: everything that must be split alike has to be in the set.
-      std::vector<unsigned int> missing, around;
-      for (const auto &[e, t] : edge_t)
-      {
-        around.clear();
-        mesh.tets_around_edge(e.first, e.second, around);
-        for (const unsigned int n : around)
-          if (!in_set.count(n))
-            missing.push_back(n);
-      }
-      // A vertex joining the crack needs its whole star (its copies are decided on
-      // it): a vertex newly on the surface, or one of a cell that is cut now. Old
-      // crack vertices elsewhere stay as they are, so the set does not spread along
-      // the whole crack.
-      needs_star.clear();
-      for (const unsigned int t : affected)
-      {
-        const mesh::Tet &tet    = mesh.tet(t);
-        bool             is_cut = false;
-        for (const auto &e : tet_edge_vertices)
-          is_cut = is_cut
-                   || edge_t.count(
-                     {std::min(tet[e[0]], tet[e[1]]), std::max(tet[e[0]], tet[e[1]])});
-        for (const auto &fv : mesh::TetMesh::face_vertices)
-          is_cut =
-            is_cut || front_points.count(sorted3(tet[fv[0]], tet[fv[1]], tet[fv[2]]));
-        for (const unsigned int v : tet)
-          if (side[v] == 0 && (is_cut || v >= on_surface.size() || !on_surface[v]))
-            needs_star.insert(v);
-      }
-      for (const unsigned int v : needs_star)
-        for (const unsigned int n : mesh.tets_of_vertex(v))
-          if (!in_set.count(n))
-            missing.push_back(n);
-      for (const auto &[f, p] : front_points)
-      {
-        around.clear();
-        mesh.tets_around_edge(f[0], f[1], around);
-        for (const unsigned int n : around)
-        {
-          const mesh::Tet &q = mesh.tet(n);
-          if (std::find(q.begin(), q.end(), f[2]) != q.end() && !in_set.count(n))
-            missing.push_back(n);
-        }
-      }
-      closed = missing.empty();
-      for (const unsigned int n : missing)
-        if (in_set.insert(n).second)
-          affected.push_back(n);
-    }
-    if (!closed)
+    ++affected_stamp;
+    affected = candidates;
+    for (const unsigned int t : affected)
+      tet_mark[t] = affected_stamp;
+    if (!analyse(surface))
     {
       ++statistics.postponed;
+      spent();
       return;
     }
     // One TetCut per affected tetrahedron; split them all before changing anything.
-    std::vector<unsigned int> removed;
-    std::vector<TetCut>       cuts;
+    removed.clear();
+    cuts.clear();
     for (const unsigned int t : affected)
     {
       const mesh::Tet &tet = mesh.tet(t);
@@ -555,29 +370,26 @@ namespace lacerta::cut
       {
         c.vertex_ids[i]  = tet[i];
         c.points[i]      = mesh.vertex(tet[i]);
-        c.vertex_side[i] = side[tet[i]];
-        touched |= needs_star.count(tet[i]) > 0;
+        c.vertex_side[i] = vertex_scratch[tet[i]].side;
+        touched |= vertex_scratch[tet[i]].star_stamp == star_stamp;
       }
       for (unsigned int e = 0; e < 6; ++e)
       {
-        const unsigned int a = tet[tet_edge_vertices[e][0]],
-                           b = tet[tet_edge_vertices[e][1]];
-        const auto it        = edge_t.find({std::min(a, b), std::max(a, b)});
-        if (it != edge_t.end())
+        const EdgeScratch &es = edge_scratch[mesh.tet_edges(t)[e]];
+        if (es.reached)
         {
           c.cut_edges |= std::uint8_t(1u << e);
-          c.edge_parameter[e] = it->second;
+          c.edge_parameter[e] = es.t;
           touched             = true;
         }
       }
       for (unsigned int f = 0; f < 4; ++f)
       {
-        const auto &fv = mesh::TetMesh::face_vertices[f];
-        const auto  it = front_points.find(sorted3(tet[fv[0]], tet[fv[1]], tet[fv[2]]));
-        if (it != front_points.end())
+        const FaceScratch &fs = face_scratch[4 * t + f];
+        if (fs.has_front)
         {
           c.front_faces |= std::uint8_t(1u << f);
-          c.front_points[f] = it->second.first;
+          c.front_points[f] = fs.rest;
           touched           = true;
         }
       }
@@ -590,104 +402,419 @@ namespace lacerta::cut
     if (removed.empty())
     {
       front = end;
+      spent();
       return;
     }
-    std::vector<SplitResult> results(cuts.size());
-    bool                     separates = false;
+    results.resize(cuts.size());
+    bool separates = false, any_cut = false;
     for (std::size_t k = 0; k < cuts.size(); ++k)
     {
       const CutKind kind = split_tetrahedron(cuts[k], results[k], eps);
-      if (kind == CutKind::unsupported)
-      {
-        // Postpone: the crack front waits until the configuration is one the table
-        // describes; after a few tries the stroke restarts from the blade.
-        if (++n_postponed > 8)
-        {
-          front = end;
-          end_stroke();
-          n_postponed = 0;
-        }
-        ++statistics.postponed;
-        return;
-      }
-      separates |= kind == CutKind::complete || kind == CutKind::partial;
-      // A partial split can leave a sliver next to a vertex ahead of the front (its
-      // crossing is not cut yet, so it has not snapped; doc/split-table.md). Such a
-      // split is postponed until the crack has left the cell, when the complete split
-      // is the one-stroke split and keeps its edges long.
-      // Every child must be a sound element at rest: a vertex kept on the surface
-      // from an earlier sweep lies within ε of the plane, not on it, and the table's
-      // children through it can then be flat. Postponed like the slivers below.
-      double longest_parent = 0;
-      for (const auto &e : tet_edge_vertices)
-        longest_parent =
-          std::max(longest_parent, norm(sub(cuts[k].points[e[1]], cuts[k].points[e[0]])));
-      for (unsigned int i = 0; i < results[k].n_children; ++i)
-      {
-        std::array<Point, 4> p;
-        for (unsigned int j = 0; j < 4; ++j)
-        {
-          const NodeRef &n = results[k].children[i].nodes[j];
-          p[j]             = n.kind == NodeKind::vertex       ? cuts[k].points[n.index]
-                             : n.kind == NodeKind::edge_point ? results[k].edge_points[n.index]
-                             : n.kind == NodeKind::face_point ? results[k].face_points[n.index]
-                                                              : results[k].interior_point;
-        }
-        if (!(volume(p[0], p[1], p[2], p[3])
-              > 1e-6 * longest_parent * longest_parent * longest_parent))
-        {
-          if (++n_postponed > 8)
-          {
-            front = end;
-            end_stroke();
-            n_postponed = 0;
-          }
-          ++statistics.postponed;
-          return;
-        }
-      }
-      if (kind == CutKind::partial || kind == CutKind::refinement)
+      // Postponed (the crack front waits; the next sweep, from the same front, covers
+      // more): a configuration the table does not describe; a second partial split of
+      // a cell the front has not left yet (it is continued when the front leaves it,
+      // by the complete split of the children ahead of the old front, instead of
+      // being re-split at every sweep); a child flat at rest (a vertex kept on the
+      // surface lies within ε of the plane, not on it); a partial split that would
+      // make a sliver next to a vertex ahead of the front.
+      // (When the blade has left the tissue the front must catch up where it is: no
+      // deferral and no waiting for a better front.)
+      const bool must_follow = active.empty();
+      bool       postpone    = kind == CutKind::unsupported
+                      || (kind == CutKind::partial && partial_child[removed[k]] == stroke
+                          && !must_follow)
+                      || has_flat_child(cuts[k], results[k]);
+      if (!postpone && !must_follow
+          && (kind == CutKind::partial || kind == CutKind::refinement))
       {
         double shortest_parent = 1e300;
         for (const auto &e : tet_edge_vertices)
           shortest_parent =
             std::min(shortest_parent,
                      norm(sub(cuts[k].points[e[1]], cuts[k].points[e[0]])));
-        if (shortest_child_edge(cuts[k], results[k]) < 0.5 * eps * shortest_parent)
+        postpone = shortest_child_edge(cuts[k], results[k]) < 0.5 * eps * shortest_parent;
+      }
+      if (postpone)
+      {
+        ++statistics.postponed;
+        spent();
+        return;
+      }
+      separates |= kind == CutKind::complete || kind == CutKind::partial;
+      any_cut |= kind != CutKind::none && kind != CutKind::touch;
+    }
+    if (!separates && !any_cut)
+    {
+      bool any_edge = false;
+      for (const unsigned int e : edge_list)
+        any_edge |= edge_scratch[e].reached;
+      if (!any_edge)
+      {
+        // Only touching and nothing joins the crack: nothing to change yet.
+        bool joins = false;
+        for (const unsigned int v : verts)
+          joins |= vertex_scratch[v].star_stamp == star_stamp;
+        for (const unsigned int v : group_extra)
+          joins |= vertex_scratch[v].star_stamp == star_stamp;
+        if (!joins)
         {
-          ++statistics.postponed;
+          front = end;
+          spent();
           return;
         }
       }
     }
-    n_postponed = 0;
-    if (!separates
-        && std::all_of(results.begin(),
-                       results.end(),
-                       [](const SplitResult &r)
-                       { return r.kind == CutKind::none || r.kind == CutKind::touch; })
-        && edge_t.empty())
+    apply(end, statistics);
+    stroke_has_cut = true;
+    spent();
+    front = end;
+  }
+
+
+  bool
+  Cutter::has_flat_child(const TetCut &cut, const SplitResult &result) const
+  {
+    double longest_parent = 0;
+    for (const auto &e : tet_edge_vertices)
+      longest_parent =
+        std::max(longest_parent, norm(sub(cut.points[e[1]], cut.points[e[0]])));
+    for (unsigned int i = 0; i < result.n_children; ++i)
     {
-      // Only touching: nothing to change yet (vertices on the surface wait).
-      front = end;
-      return;
+      const auto p = child_node_points(cut, result, result.children[i]);
+      if (!(volume(p[0], p[1], p[2], p[3])
+            > 1e-6 * longest_parent * longest_parent * longest_parent))
+        return true;
     }
+    return false;
+  }
 
-    // The record of this sweep for the Multi-Triangulation (set_recorder()).
-    CutRecord *record = recorder ? &recorder->emplace_back() : nullptr;
-    if (record)
-      record->cuts = cuts;
 
-    // Mass and stiffness contributions of the tetrahedra that go.
-    std::map<unsigned int, double>                              mass_delta;
-    std::vector<std::pair<std::array<unsigned int, 2>, double>> stiffness_delta;
-    double                                                      integral_delta = 0;
+  void
+  Cutter::prepare_scratch()
+  {
+    vertex_scratch.resize(mesh.n_vertices());
+    edge_scratch.resize(mesh.n_edges());
+    face_scratch.resize(4 * std::size_t(mesh.n_tets()));
+    tet_mark.resize(mesh.n_tets(), 0);
+    partial_child.resize(mesh.n_tets(), 0);
+    on_surface.resize(mesh.n_vertices(), 0);
+    swept.resize(mesh.n_vertices(), 0);
+  }
+
+
+  Cutter::VertexScratch &
+  Cutter::vertex_data(const unsigned int v, const SweepSurface &surface)
+  {
+    VertexScratch &s = vertex_scratch[v];
+    if (s.stamp == analysis_stamp)
+      return s;
+    s.stamp       = analysis_stamp;
+    const Point x = position(v);
+    double      d = surface.distance(x);
+    if (std::abs(d) <= 1e-12 * typical_edge)
+      d = 0;
+    s.d = d;
+    s.on_plane =
+      d == 0 || (on_surface[v] && std::abs(d) <= parameters.snap_fraction * typical_edge);
+    // Reached: a vertex of the crack when behind the new front; a fresh one when also
+    // not behind the start of this sweep by more than a cell (the plane must not
+    // reach back along an older part of the crack), or when an earlier sweep of the
+    // stroke swept it.
+    s.reached = on_surface[v]
+                  ? surface.behind(x) < 0
+                  : (surface.behind(x) < 0 && surface.ahead_of_start(x) >= -start_reach)
+                      || swept[v] == stroke;
+    s.parent  = v;
+    return s;
+  }
+
+
+  bool
+  Cutter::analyse(const SweepSurface &surface)
+  {
+    const double eps = parameters.snap_fraction;
+    for (unsigned int iteration = 0; iteration < 8; ++iteration)
+    {
+      ++analysis_stamp;
+      verts.clear();
+      edge_list.clear();
+      for (const unsigned int t : affected)
+      {
+        const mesh::Tet &tet = mesh.tet(t);
+        for (const unsigned int v : tet)
+          if (vertex_scratch[v].stamp != analysis_stamp)
+          {
+            vertex_data(v, surface);
+            verts.push_back(v);
+          }
+        for (const unsigned int e : mesh.tet_edges(t))
+          if (edge_scratch[e].stamp != analysis_stamp)
+          {
+            edge_scratch[e].stamp    = analysis_stamp;
+            edge_scratch[e].crossing = false;
+            edge_scratch[e].reached  = false;
+            edge_list.push_back(e);
+          }
+      }
+      const auto &edges = mesh.get_edges();
+      // Snapping: a vertex on the surface (exactly, kept from earlier sweeps of the
+      // stroke, or snapped by a crossing close to it) has no cut edge.
+      for (const unsigned int e : edge_list)
+      {
+        VertexScratch &a = vertex_scratch[edges[e][0]], &b = vertex_scratch[edges[e][1]];
+        if (!a.on_plane && !b.on_plane && a.d * b.d < 0)
+        {
+          const EdgeSnap snap = snap_edge_parameter(a.d / (a.d - b.d), eps);
+          if (snap == EdgeSnap::first_vertex)
+            a.on_plane = true;
+          else if (snap == EdgeSnap::second_vertex)
+            b.on_plane = true;
+        }
+      }
+      // Vertices on the surface joined by edges in the surface are reached together
+      // (the front never crosses such an edge): the whole connected patch, followed
+      // beyond the affected cells through the vertex stars, waits until all of it
+      // has been swept. Its vertices outside the affected set join it when reached.
+      group_extra.clear();
+      const auto root = [&](unsigned int v)
+      {
+        while (vertex_scratch[v].parent != v)
+          v = vertex_scratch[v].parent = vertex_scratch[vertex_scratch[v].parent].parent;
+        return v;
+      };
+      // Inside the affected cells: the edges in the surface.
+      for (const unsigned int e : edge_list)
+        if (vertex_scratch[edges[e][0]].on_plane && vertex_scratch[edges[e][1]].on_plane)
+          vertex_scratch[root(edges[e][0])].parent = root(edges[e][1]);
+      // Beyond them, from the fresh vertices on the plane (not yet on the crack: the
+      // crack already made is reached and need not be walked) through their stars.
+      group.clear();
+      for (const unsigned int v : verts)
+        if (vertex_scratch[v].on_plane && !on_surface[v])
+          group.push_back(v);
+      for (std::size_t q = 0; q < group.size(); ++q)
+      {
+        const unsigned int u = group[q];
+        for (const unsigned int t : mesh.tets_of_vertex(u))
+        {
+          if (tet_mark[t] == affected_stamp)
+            continue;
+          for (const unsigned int w : mesh.tet(t))
+          {
+            if (w == u || on_surface[w])
+              continue;
+            const bool     is_new = vertex_scratch[w].stamp != analysis_stamp;
+            VertexScratch &s      = vertex_data(w, surface);
+            if (!s.on_plane)
+              continue;
+            if (is_new)
+            {
+              group_extra.push_back(w);
+              group.push_back(w);
+            }
+            vertex_scratch[root(w)].parent = root(u);
+          }
+        }
+      }
+      for (const unsigned int v : verts)
+        vertex_scratch[v].group_reached = true;
+      for (const unsigned int v : group_extra)
+        vertex_scratch[v].group_reached = true;
+      const auto gather = [&](const unsigned int v)
+      {
+        VertexScratch &s = vertex_scratch[v];
+        if (!s.on_plane)
+          return;
+        if (s.reached && !on_surface[v])
+          swept[v] = stroke;
+        if (!s.reached)
+          vertex_scratch[root(v)].group_reached = false;
+      };
+      for (const unsigned int v : verts)
+        gather(v);
+      for (const unsigned int v : group_extra)
+        gather(v);
+      for (const unsigned int v : verts)
+        if (vertex_scratch[v].on_plane)
+          vertex_scratch[v].reached = vertex_scratch[root(v)].group_reached;
+      for (const unsigned int v : group_extra)
+        vertex_scratch[v].reached = vertex_scratch[root(v)].group_reached;
+      for (const unsigned int v : verts)
+      {
+        VertexScratch &s = vertex_scratch[v];
+        s.side           = s.on_plane && s.reached ? 0 : (s.d >= 0 ? 1 : -1);
+      }
+      for (const unsigned int v : group_extra)
+      {
+        VertexScratch &s = vertex_scratch[v];
+        s.side           = s.on_plane && s.reached ? 0 : (s.d >= 0 ? 1 : -1);
+      }
+      // Crossings of the surface; the reached ones are cut.
+      for (const unsigned int e : edge_list)
+      {
+        EdgeScratch         &es = edge_scratch[e];
+        const VertexScratch &a  = vertex_scratch[edges[e][0]],
+                            &b  = vertex_scratch[edges[e][1]];
+        if (a.on_plane || b.on_plane || !(a.d * b.d < 0))
+          continue;
+        es.t          = a.d / (a.d - b.d);
+        const Point p = lerp(position(edges[e][0]), position(edges[e][1]), es.t);
+        if (surface.ahead_of_start(p) < -start_reach)
+          continue;
+        es.crossing = true;
+        es.reached  = surface.behind(p) < 0;
+      }
+      // Front points, once per face, from the face's two section corners.
+      for (const unsigned int t : affected)
+        for (unsigned int f = 0; f < 4; ++f)
+        {
+          FaceScratch &fs = face_scratch[4 * t + f];
+          if (fs.stamp == analysis_stamp)
+            continue;
+          fs.stamp     = analysis_stamp;
+          fs.has_front = false;
+          compute_front_point(t, f, surface, fs);
+          // The face seen from the neighbour gets the same front point.
+          const unsigned int n = mesh.neighbor(t, f);
+          if (n != mesh::invalid_index)
+            for (unsigned int g = 0; g < 4; ++g)
+              if (mesh.neighbor(n, g) == t)
+                face_scratch[4 * n + g] = fs;
+        }
+      // Closure: everything that must be split alike has to be in the set.
+      missing.clear();
+      ++star_stamp;
+      for (const unsigned int e : edge_list)
+        if (edge_scratch[e].reached)
+        {
+          around.clear();
+          mesh.tets_around_edge(edges[e][0], edges[e][1], around);
+          for (const unsigned int n : around)
+            if (tet_mark[n] != affected_stamp)
+              missing.push_back(n);
+        }
+      // A vertex joining the crack needs its whole star (its copies are decided on
+      // it): a vertex newly on the surface, or one of a cell that is cut now. Old
+      // crack vertices elsewhere stay as they are, so the set does not spread along
+      // the whole crack.
+      for (const unsigned int t : affected)
+      {
+        const bool is_cut = tet_is_cut(t);
+        for (const unsigned int v : mesh.tet(t))
+          if (vertex_scratch[v].side == 0 && (is_cut || !on_surface[v]))
+            vertex_scratch[v].star_stamp = star_stamp;
+      }
+      for (const unsigned int v : group_extra)
+        if (vertex_scratch[v].side == 0 && !on_surface[v])
+          vertex_scratch[v].star_stamp = star_stamp;
+      for (const unsigned int v : verts)
+        if (vertex_scratch[v].star_stamp == star_stamp)
+          for (const unsigned int n : mesh.tets_of_vertex(v))
+            if (tet_mark[n] != affected_stamp)
+              missing.push_back(n);
+      for (const unsigned int v : group_extra)
+        if (vertex_scratch[v].star_stamp == star_stamp)
+          for (const unsigned int n : mesh.tets_of_vertex(v))
+            if (tet_mark[n] != affected_stamp)
+              missing.push_back(n);
+      for (const unsigned int t : affected)
+        for (unsigned int f = 0; f < 4; ++f)
+          if (face_scratch[4 * t + f].has_front)
+          {
+            const unsigned int n = mesh.neighbor(t, f);
+            if (n != mesh::invalid_index && tet_mark[n] != affected_stamp)
+              missing.push_back(n);
+          }
+      if (missing.empty())
+        return true;
+      for (const unsigned int n : missing)
+        if (tet_mark[n] != affected_stamp)
+        {
+          tet_mark[n] = affected_stamp;
+          affected.push_back(n);
+        }
+    }
+    return false;
+  }
+
+
+  bool
+  Cutter::tet_is_cut(const unsigned int t) const
+  {
+    for (const unsigned int e : mesh.tet_edges(t))
+      if (edge_scratch[e].reached)
+        return true;
+    for (unsigned int f = 0; f < 4; ++f)
+      if (face_scratch[4 * t + f].has_front)
+        return true;
+    return false;
+  }
+
+
+  void
+  Cutter::compute_front_point(const unsigned int  t,
+                              const unsigned int  f,
+                              const SweepSurface &surface,
+                              FaceScratch        &fs)
+  {
+    const mesh::Tet                  &tet = mesh.tet(t);
+    const auto                       &fv  = mesh::TetMesh::face_vertices[f];
+    const std::array<unsigned int, 3> v{{tet[fv[0]], tet[fv[1]], tet[fv[2]]}};
+    std::array<SectionCorner, 3>      corners;
+    unsigned int                      n_corners = 0, vertex_corners = 0;
+    for (unsigned int k = 0; k < 3; ++k)
+      if (vertex_scratch[v[k]].on_plane)
+      {
+        corners[n_corners++] = {mesh.vertex(v[k]),
+                                position(v[k]),
+                                vertex_scratch[v[k]].reached};
+        ++vertex_corners;
+      }
+    for (unsigned int k = 0; k < 3 && n_corners < 3; ++k)
+    {
+      const unsigned int a = std::min(v[k], v[(k + 1) % 3]),
+                         b = std::max(v[k], v[(k + 1) % 3]);
+      // The edge's id: the local edge of t joining the two local vertices.
+      const int          local = tet_edge_of_vertices[fv[k]][fv[(k + 1) % 3]];
+      const EdgeScratch &es    = edge_scratch[mesh.tet_edges(t)[local]];
+      if (!es.crossing)
+        continue;
+      corners[n_corners++] = {lerp(mesh.vertex(a), mesh.vertex(b), es.t),
+                              lerp(position(a), position(b), es.t),
+                              es.reached};
+    }
+    Point rest, now;
+    if (front_point_on_face(
+          corners.data(),
+          n_corners,
+          vertex_corners,
+          [&](const Point &x) { return surface.behind(x); },
+          parameters.snap_fraction,
+          rest,
+          now))
+    {
+      fs.has_front = true;
+      fs.rest      = rest;
+      fs.now       = now;
+    }
+  }
+
+
+  void
+  Cutter::apply(const Blade &end, CutStepStatistics &statistics)
+  {
+    // Contributions of the tetrahedra that go: masses straight from the particles,
+    // stiffnesses by edge after the mesh update (the edge ids move).
+    stiffness_delta.clear();
+    touched_vertices.clear();
+    double integral_delta = 0;
     for (const unsigned int r : removed)
     {
       const auto m = physics::tet_mass_contributions(mesh, r, density);
       for (unsigned int i = 0; i < 4; ++i)
       {
-        mass_delta[mesh.tet(r)[i]] -= m[i];
+        system.mass[mesh.tet(r)[i]] -= m[i];
+        touched_vertices.push_back(mesh.tet(r)[i]);
         integral_delta -= m[i];
       }
       const double f = physics::tet_stiffness_factor(mesh, r, youngs_modulus);
@@ -695,13 +822,20 @@ namespace lacerta::cut
         stiffness_delta.push_back({{{mesh.tet(r)[e[0]], mesh.tet(r)[e[1]]}}, -f});
     }
 
-    // New points, merged across tetrahedra by their keys; state interpolated from the
-    // parent (the same affine map at rest and deformed).
-    std::map<PointKey, unsigned int>         ids;
-    std::vector<mesh::Tet>                   children;
-    std::vector<std::array<unsigned int, 4>> face_ids;
-    std::set<std::array<unsigned int, 3>>    cut_faces;
-    std::vector<std::array<unsigned int, 2>> child_origin; // (split, child), recording
+    // New points, merged across tetrahedra through the edge and face they lie on (one
+    // particle per edge and side, per face); state interpolated from the parent (the
+    // same affine map at rest and deformed).
+    ++merge_stamp;
+    children.clear();
+    child_cut_faces.clear();
+    face_ids.clear();
+    // The record of this sweep for the Multi-Triangulation (set_recorder()).
+    CutRecord *record = recorder ? &recorder->emplace_back() : nullptr;
+    if (record)
+    {
+      record->cuts = cuts;
+      child_origin.clear();
+    }
     const auto new_particle = [&](const Point &rest, const unsigned int parent)
     {
       const mesh::Tet &tet = mesh.tet(parent);
@@ -719,14 +853,20 @@ namespace lacerta::cut
         }
       const unsigned int id = mesh.add_vertex(rest);
       system.add_particle(rest, x, v);
-      on_surface.resize(mesh.n_vertices(), 0);
       ++statistics.new_particles;
       return id;
     };
     for (std::size_t k = 0; k < cuts.size(); ++k)
     {
-      const TetCut      &c = cuts[k];
-      const SplitResult &r = results[k];
+      const TetCut      &c        = cuts[k];
+      const SplitResult &r        = results[k];
+      const unsigned int parent   = removed[k];
+      unsigned int       interior = mesh::invalid_index;
+      if (r.kind != CutKind::none && r.kind != CutKind::touch)
+      {
+        statistics.cut_tets += 1;
+        statistics.created_tets += r.n_children;
+      }
       for (unsigned int i = 0; i < r.n_children; ++i)
       {
         const Child &child = r.children[i];
@@ -734,46 +874,85 @@ namespace lacerta::cut
         for (unsigned int j = 0; j < 4; ++j)
         {
           const NodeRef &n = child.nodes[j];
-          if (n.kind == NodeKind::vertex)
+          unsigned int  *slot;
+          switch (n.kind)
           {
-            t[j] = static_cast<unsigned int>(c.vertex_ids[n.index]);
-            continue;
+            case NodeKind::vertex:
+              t[j] = static_cast<unsigned int>(c.vertex_ids[n.index]);
+              continue;
+            case NodeKind::edge_point:
+            {
+              EdgeScratch &es = edge_scratch[mesh.tet_edges(parent)[n.index]];
+              if (es.point_stamp != merge_stamp)
+              {
+                es.point_stamp = merge_stamp;
+                es.point       = {
+                        {mesh::invalid_index, mesh::invalid_index, mesh::invalid_index}};
+              }
+              slot = &es.point[point_key(c.vertex_ids, n, parent).side + 1];
+              break;
+            }
+            case NodeKind::face_point:
+            {
+              FaceScratch &fs = face_scratch[4 * parent + n.index];
+              if (fs.point_stamp != merge_stamp)
+              {
+                fs.point_stamp = merge_stamp;
+                fs.point       = mesh::invalid_index;
+              }
+              slot = &fs.point;
+              break;
+            }
+            default:
+              slot = &interior;
+              break;
           }
-          const PointKey key = point_key(c.vertex_ids, n, removed[k]);
-          const auto     it  = ids.find(key);
-          if (it != ids.end())
-            t[j] = it->second;
-          else
+          if (*slot == mesh::invalid_index)
           {
             const Point p = n.kind == NodeKind::edge_point   ? r.edge_points[n.index]
                             : n.kind == NodeKind::face_point ? r.face_points[n.index]
                                                              : r.interior_point;
-            t[j]          = new_particle(p, removed[k]);
-            if (n.kind != NodeKind::interior_point)
-            {
-              on_surface[t[j]] = 1;
-              on_surface_list.push_back(t[j]);
-            }
-            ids.emplace(key, t[j]);
+            *slot         = new_particle(p, parent);
             if (record)
             {
-              CutRecord::NewPoint point{t[j], n.kind, key.side, {}, p};
-              for (unsigned int m = 0; m < 4; ++m)
-                point.ids[m] = n.kind == NodeKind::interior_point
-                                 ? static_cast<unsigned int>(c.vertex_ids[m])
-                                 : (m < 3 ? static_cast<unsigned int>(key.ids[m]) : 0);
-              std::sort(point.ids.begin(),
-                        point.ids.begin() + (n.kind == NodeKind::interior_point ? 4 : 0));
+              CutRecord::NewPoint point{*slot, n.kind, 0, {}, p};
+              if (n.kind == NodeKind::interior_point)
+              {
+                for (unsigned int m = 0; m < 4; ++m)
+                  point.ids[m] = static_cast<unsigned int>(c.vertex_ids[m]);
+                std::sort(point.ids.begin(), point.ids.end());
+              }
+              else
+              {
+                const auto key = point_key(c.vertex_ids, n, parent);
+                point.side     = key.side;
+                for (unsigned int m = 0; m < 3; ++m)
+                  point.ids[m] = static_cast<unsigned int>(key.ids[m]);
+              }
               record->new_points.push_back(point);
             }
+            if (n.kind == NodeKind::face_point)
+            {
+              // The same point for the cell across the face.
+              const unsigned int nb = mesh.neighbor(parent, n.index);
+              if (nb != mesh::invalid_index)
+                for (unsigned int g = 0; g < 4; ++g)
+                  if (mesh.neighbor(nb, g) == parent)
+                  {
+                    face_scratch[4 * nb + g].point_stamp = merge_stamp;
+                    face_scratch[4 * nb + g].point       = *slot;
+                  }
+            }
+            if (n.kind != NodeKind::interior_point)
+              mark_on_surface(*slot);
           }
+          t[j] = *slot;
         }
         std::array<unsigned int, 4> fid{{0, 0, 0, 0}};
         for (unsigned int j = 0; j < 4; ++j)
         {
           if (child.cut_faces & (1u << j))
           {
-            cut_faces.insert(sorted3(t[(j + 1) % 4], t[(j + 2) % 4], t[(j + 3) % 4]));
             fid[j] = cut_boundary_id;
             continue;
           }
@@ -784,89 +963,81 @@ namespace lacerta::cut
             for (unsigned int m = 0; m < 4; ++m)
               if (m != j)
                 on = on && node_on_parent_face(child.nodes[m], f);
-            const unsigned int id = mesh.boundary_id(removed[k], f);
+            const unsigned int id = mesh.boundary_id(parent, f);
             if (on && id != mesh::invalid_index)
               fid[j] = id;
           }
         }
         children.push_back(t);
-        face_ids.push_back(fid);
         if (record)
           child_origin.push_back({{static_cast<unsigned int>(k), i}});
+        child_cut_faces.push_back(child.cut_faces);
+        face_ids.push_back(fid);
+        child_partial.push_back(r.kind == CutKind::partial);
       }
     }
     // Vertices on the cut: one copy per group of their children connected through
     // faces not on the cut, so that the two sides separate where the crack is open
     // and stay joined at the crack tip.
-    std::map<unsigned int, std::vector<std::size_t>> incident;
+    incidences.clear();
     for (std::size_t k = 0; k < children.size(); ++k)
       for (const unsigned int v : children[k])
-        if (needs_star.count(v))
-          incident[v].push_back(k);
-    for (const auto &[v, list] : incident)
+        if (v < vertex_scratch.size() && vertex_scratch[v].stamp == analysis_stamp
+            && vertex_scratch[v].star_stamp == star_stamp)
+          incidences.push_back({{v, static_cast<unsigned int>(k)}});
+    std::sort(incidences.begin(), incidences.end());
+    for (std::size_t b = 0; b < incidences.size();)
     {
-      Groups                                             groups(list.size());
-      std::map<std::array<unsigned int, 3>, std::size_t> first_with_face;
-      for (std::size_t i = 0; i < list.size(); ++i)
+      const unsigned int v = incidences[b][0];
+      std::size_t        e = b;
+      star.clear();
+      while (e < incidences.size() && incidences[e][0] == v)
       {
-        const mesh::Tet &t = children[list[i]];
-        for (unsigned int f = 0; f < 4; ++f)
-        {
-          const auto face = sorted3(t[(f + 1) % 4], t[(f + 2) % 4], t[(f + 3) % 4]);
-          if (t[f] == v || cut_faces.count(face))
-            continue;
-          const auto [it, inserted] = first_with_face.emplace(face, i);
-          if (!inserted)
-            groups.join(i, it->second);
-        }
+        const mesh::Tet &c = children[incidences[e][1]];
+        star.push_back({{{c[0], c[1], c[2], c[3]}}, child_cut_faces[incidences[e][1]]});
+        ++e;
       }
-      std::map<std::size_t, unsigned int> copy_of_root;
-      for (std::size_t i = 0; i < list.size(); ++i)
+      const unsigned int n_groups = separate_star(v, star, star_group);
+      copy_ids.assign(n_groups, v);
+      for (unsigned int g = 1; g < n_groups; ++g)
       {
-        const std::size_t root = groups.find(i);
-        if (copy_of_root.empty())
-          copy_of_root[root] = v;
-        auto it = copy_of_root.find(root);
-        if (it == copy_of_root.end())
-        {
-          const unsigned int copy = mesh.add_vertex(mesh.vertex(v));
-          system.add_particle(mesh.vertex(v),
-                              position(v),
-                              {{system.velocity[3 * v],
-                                system.velocity[3 * v + 1],
-                                system.velocity[3 * v + 2]}});
-          on_surface.resize(mesh.n_vertices(), 0);
-          on_surface[copy] = 1;
-          on_surface_list.push_back(copy);
-          ++statistics.new_particles;
-          it = copy_of_root.emplace(root, copy).first;
-          if (record)
-            record->new_points.push_back(
-              {copy, NodeKind::vertex, 0, {{v, 0, 0, 0}}, mesh.vertex(v)});
-        }
+        const unsigned int copy = mesh.add_vertex(mesh.vertex(v));
+        system.add_particle(mesh.vertex(v),
+                            position(v),
+                            {{system.velocity[3 * v],
+                              system.velocity[3 * v + 1],
+                              system.velocity[3 * v + 2]}});
+        // A copy keeps its original's constraint (the scene extends its particle
+        // lists from `copied_particles`).
+        system.free[copy] = system.free[v];
+        statistics.copied_particles.push_back({{v, copy}});
+        mark_on_surface(copy);
+        ++statistics.new_particles;
+        copy_ids[g] = copy;
         if (record)
-          for (unsigned int m = 0; m < 4; ++m)
-            if (children[list[i]][m] == v)
-              record->vertex_choices.push_back(
-                {child_origin[list[i]][0],
-                 static_cast<std::uint8_t>(child_origin[list[i]][1]),
-                 static_cast<std::uint8_t>(m),
-                 it->second});
-        for (auto &node : children[list[i]])
-          if (node == v)
-            node = it->second;
+          record->new_points.push_back(
+            {copy, NodeKind::vertex, 0, {{v, 0, 0, 0}}, mesh.vertex(v)});
       }
-    }
-    for (const unsigned int v : needs_star)
-      if (!on_surface[v])
+      for (std::size_t i = 0; i < star.size(); ++i)
       {
-        on_surface[v] = 1;
-        on_surface_list.push_back(v);
+        const unsigned int child = incidences[b + i][1];
+        for (unsigned int m = 0; m < 4; ++m)
+          if (children[child][m] == v)
+          {
+            children[child][m] = copy_ids[star_group[i]];
+            if (record)
+              record->vertex_choices.push_back(
+                {child_origin[child][0],
+                 static_cast<std::uint8_t>(child_origin[child][1]),
+                 static_cast<std::uint8_t>(m),
+                 copy_ids[star_group[i]]});
+          }
       }
+      mark_on_surface(v);
+      b = e;
+    }
 
     // The mesh, locally.
-    std::vector<unsigned int> added_ids;
-    mesh::TetMesh::EdgeUpdate edge_update;
     mesh.replace_tets(removed, children, face_ids, added_ids, edge_update);
 
     // Springs follow the edges: appended, moved into retired slots, restiffened.
@@ -891,12 +1062,15 @@ namespace lacerta::cut
       springs.stiffness.pop_back();
       springs.rest_length.pop_back();
     }
-    for (const unsigned int t : added_ids)
+    prepare_scratch();
+    for (std::size_t k = 0; k < added_ids.size(); ++k)
     {
-      const auto m = physics::tet_mass_contributions(mesh, t, density);
+      const unsigned int t = added_ids[k];
+      const auto         m = physics::tet_mass_contributions(mesh, t, density);
       for (unsigned int i = 0; i < 4; ++i)
       {
-        mass_delta[mesh.tet(t)[i]] += m[i];
+        system.mass[mesh.tet(t)[i]] += m[i];
+        touched_vertices.push_back(mesh.tet(t)[i]);
         integral_delta += m[i];
       }
       const double f = physics::tet_stiffness_factor(mesh, t, youngs_modulus);
@@ -905,36 +1079,48 @@ namespace lacerta::cut
       for (unsigned int f2 = 0; f2 < 4; ++f2)
         if (mesh.neighbor(t, f2) == mesh::invalid_index)
           tree.add_face(mesh, t, f2);
+      // Children of a partial split are not split partially again in this stroke.
+      partial_child[t] = child_partial[k] ? stroke : 0;
     }
+    child_partial.clear();
     for (const auto &[pair, f] : stiffness_delta)
     {
       const unsigned int e = mesh.find_edge(pair[0], pair[1]);
       if (e != mesh::invalid_index)
         springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
     }
-    for (const auto &[v, dm] : mass_delta)
-      system.mass[v] += dm;
     // A vertex that lost all its cells cannot happen (copies take over whole stars),
     // but a mass that rounding left a hair below zero would be nonsense: clamp.
-    for (const auto &[v, dm] : mass_delta)
+    for (const unsigned int v : touched_vertices)
       if (system.mass[v] < 0)
         system.mass[v] = 0;
     integral_of_density += integral_delta;
 
     // The active cells: the new ones the blade is in.
+    std::sort(removed.begin(), removed.end());
     active.erase(std::remove_if(active.begin(),
                                 active.end(),
-                                [&](unsigned int t) { return in_set.count(t) > 0; }),
+                                [&](unsigned int t) {
+                                  return std::binary_search(removed.begin(),
+                                                            removed.end(),
+                                                            t);
+                                }),
                  active.end());
     for (const unsigned int t : added_ids)
       if (blade_in_tet(t, end))
         active.push_back(t);
-
-    statistics.cut_tets += static_cast<unsigned int>(removed.size());
-    statistics.created_tets += static_cast<unsigned int>(children.size());
     statistics.changed = true;
-    statistics.update_seconds +=
-      std::chrono::duration<double>(Clock::now() - t_start).count();
-    front = end;
+  }
+
+
+  void
+  Cutter::mark_on_surface(const unsigned int v)
+  {
+    on_surface.resize(mesh.n_vertices(), 0);
+    if (!on_surface[v])
+    {
+      on_surface[v] = 1;
+      on_surface_list.push_back(v);
+    }
   }
 } // namespace lacerta::cut

@@ -259,6 +259,9 @@ namespace lacerta::cut
       s.created_tets += c.created_tets;
       s.new_particles += c.new_particles;
       s.changed |= c.changed;
+      s.copied_particles.insert(s.copied_particles.end(),
+                                c.copied_particles.begin(),
+                                c.copied_particles.end());
       ++s.advances;
       u = next;
     };

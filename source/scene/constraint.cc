@@ -5,6 +5,8 @@
 
 #include <deal.II/base/utilities.h>
 
+#include <algorithm>
+
 namespace lacerta::scene
 {
   void
@@ -15,6 +17,20 @@ namespace lacerta::scene
     if (prescribes_motion())
       for (const unsigned int i : particles)
         system.free[i] = 0.0;
+  }
+
+
+  void
+  Constraint::follow_copies(const std::vector<std::array<unsigned int, 2>> &copies,
+                            physics::ParticleSystem                        &system)
+  {
+    std::vector<unsigned int> extended = particles;
+    std::sort(extended.begin(), extended.end());
+    // Copies have the largest ids so far: appending keeps the list sorted.
+    for (const auto &[original, copy] : copies)
+      if (std::binary_search(extended.begin(), extended.end(), original))
+        extended.insert(std::upper_bound(extended.begin(), extended.end(), copy), copy);
+    initialize(extended, system);
   }
 
 

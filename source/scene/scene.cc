@@ -222,6 +222,14 @@ namespace lacerta::scene
 
 
   void
+  Scene::follow_cut(const std::vector<std::array<unsigned int, 2>> &copies)
+  {
+    for (auto &constraint : constraints)
+      constraint->follow_copies(copies, *system);
+  }
+
+
+  void
   Scene::print_summary(std::ostream &out) const
   {
     const mesh::TetMesh &mesh    = active_mesh();

@@ -412,8 +412,10 @@ namespace lacerta
         cut_changed          = cut.changed;
         if (cut.changed)
         {
-          // New particles and springs: the integrator's scratch space, the stability
-          // limit and the energy baseline of the blow-up monitor start afresh.
+          // New particles and springs: the constraints take over the copies of
+          // their particles; the integrator's scratch space, the stability limit and
+          // the energy baseline of the blow-up monitor start afresh.
+          scene->follow_cut(cut.copied_particles);
           check(step);
           integrator->initialize(system);
           substeps       = choose_substeps();
@@ -451,7 +453,9 @@ namespace lacerta
             std::cout << "; " << 1e3 * tear.update_seconds << " ms";
           std::cout << "\n";
           // The scalpel's search structures must see the torn faces; then as after a
-          // cut: new scratch space, stability limit and energy baseline.
+          // cut: constraints follow the copies, new scratch space, stability limit and
+          // energy baseline.
+          scene->follow_cut(tear.copied_particles);
           scene->restart_cutter();
           check(step);
           integrator->initialize(system);
@@ -535,7 +539,12 @@ namespace lacerta
       if (!test_mode && cutting_steps > 0)
         std::cout << ", UpdT " << 1e3 * sum_update / cutting_steps << " ms, RxT "
                   << 1e3 * sum_relax / cutting_steps << " ms";
-      std::cout << "; mesh components " << cut::count_components(scene->mesh) << "\n";
+      // The pieces' rest volumes show what a cut separated (a punched hole).
+      const std::vector<double> pieces = cut::component_volumes(scene->mesh);
+      std::cout << "; mesh components " << pieces.size() << ", rest volumes (m^3)";
+      for (const double v : pieces)
+        std::cout << " " << v;
+      std::cout << "\n";
     }
     if (scene->lacerator)
     {

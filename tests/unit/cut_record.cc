@@ -53,7 +53,9 @@ namespace lacerta
       cut::test_support::stroke(cutter,
                                 path,
                                 steps,
-                                [](std::size_t, unsigned int) { return true; });
+                                [](std::size_t,
+                                   unsigned int,
+                                   const cut::CutStepStatistics &) { return true; });
       ASSERT_FALSE(records.empty());
 
       std::set<Tet> current;

@@ -8,6 +8,7 @@
  */
 #pragma once
 
+#include <lacerta/cut/cut_rules.h>
 #include <lacerta/cut/cutter.h>
 #include <lacerta/cut/geometry.h>
 #include <lacerta/cut/split_table.h>
@@ -305,12 +306,13 @@ namespace lacerta::cut::test_support
     if (surface.has_front)
       for (const auto &f : faces)
       {
-        std::vector<std::pair<Point, bool>> corners; // position, reached
-        unsigned                            vertex_corners = 0;
+        // The rule is the library's (the Cutter's): one implementation.
+        std::array<SectionCorner, 6> corners;
+        unsigned                     n_corners = 0, vertex_corners = 0;
         for (unsigned k = 0; k < 3; ++k)
           if (on_plane[f[k]])
           {
-            corners.push_back({x[f[k]], reached[f[k]]});
+            corners[n_corners++] = {x[f[k]], x[f[k]], reached[f[k]]};
             ++vertex_corners;
           }
         for (unsigned k = 0; k < 3; ++k)
@@ -319,17 +321,20 @@ namespace lacerta::cut::test_support
             const auto it = crossing_reached.find({f[k], f[l]});
             if (it == crossing_reached.end())
               continue;
-            const double t = d[f[k]] / (d[f[k]] - d[f[l]]);
-            corners.push_back({lerp(x[f[k]], x[f[l]], t), it->second});
+            const double t       = d[f[k]] / (d[f[k]] - d[f[l]]);
+            const Point  p       = lerp(x[f[k]], x[f[l]], t);
+            corners[n_corners++] = {p, p, it->second};
           }
-        if (corners.size() != 2 || corners[0].second == corners[1].second
-            || vertex_corners == 2)
-          continue;
-        const auto  &r  = corners[0].second ? corners[0] : corners[1];
-        const auto  &u  = corners[0].second ? corners[1] : corners[0];
-        const double pr = surface.behind(r.first), pu = surface.behind(u.first);
-        const double s    = clamp_front_parameter(pr / (pr - pu), eps);
-        a.front_points[f] = lerp(r.first, u.first, s);
+        Point rest, now;
+        if (front_point_on_face(
+              corners.data(),
+              n_corners,
+              vertex_corners,
+              [&](const Point &p) { return surface.behind(p); },
+              eps,
+              rest,
+              now))
+          a.front_points[f] = rest;
       }
 
     for (std::size_t k = 0; k < mesh.tets.size(); ++k)
@@ -376,35 +381,6 @@ namespace lacerta::cut::test_support
     return a;
   }
 
-  /**
-   * Positions of the nodes of a child.
-   */
-  inline std::array<Point, 4>
-  child_points(const TetCut &cut, const SplitResult &r, const Child &c)
-  {
-    std::array<Point, 4> p;
-    for (unsigned k = 0; k < 4; ++k)
-    {
-      const NodeRef &n = c.nodes[k];
-      switch (n.kind)
-      {
-        case NodeKind::vertex:
-          p[k] = cut.points[n.index];
-          break;
-        case NodeKind::edge_point:
-          p[k] = r.edge_points[n.index];
-          break;
-        case NodeKind::face_point:
-          p[k] = r.face_points[n.index];
-          break;
-        case NodeKind::interior_point:
-          p[k] = r.interior_point;
-          break;
-      }
-    }
-    return p;
-  }
-
   struct CutStatistics
   {
     std::size_t split_tets  = 0;
@@ -426,7 +402,7 @@ namespace lacerta::cut::test_support
     std::map<PointKey, std::uint32_t>         ids;
     std::vector<std::array<std::uint32_t, 4>> tets;
     std::vector<bool>                         replaced(mesh.tets.size(), false);
-    std::set<std::array<std::uint32_t, 3>>    cut_faces;
+    std::vector<std::uint8_t>                 tet_cut_faces;
     std::vector<Point>                       &points = mesh.points;
     mesh.surface                                     = surface.id;
     mesh.on_surface                                  = a.on_plane;
@@ -447,7 +423,7 @@ namespace lacerta::cut::test_support
       for (unsigned i = 0; i < r.n_children; ++i)
       {
         const Child                 &child = r.children[i];
-        const auto                   p     = child_points(c, r, child);
+        const auto                   p     = child_node_points(c, r, child);
         std::array<std::uint32_t, 4> t;
         for (unsigned j = 0; j < 4; ++j)
         {
@@ -469,15 +445,16 @@ namespace lacerta::cut::test_support
             ids.emplace(key, t[j]);
           }
         }
-        for (unsigned j = 0; j < 4; ++j)
-          if (child.cut_faces & (1u << j))
-            cut_faces.insert(sorted(t[(j + 1) % 4], t[(j + 2) % 4], t[(j + 3) % 4]));
         tets.push_back(t);
+        tet_cut_faces.push_back(child.cut_faces);
       }
     }
     for (std::size_t k = 0; k < mesh.tets.size(); ++k)
       if (!replaced[k])
+      {
         tets.push_back(mesh.tets[k]);
+        tet_cut_faces.push_back(0);
+      }
 
     // Copies of vertices on the cut: one per connected group of incident tetrahedra.
     std::map<std::uint32_t, std::vector<std::size_t>> incident;
@@ -485,49 +462,27 @@ namespace lacerta::cut::test_support
       for (const auto v : tets[k])
         if (v < a.side.size() && a.side[v] == 0)
           incident[v].push_back(k);
+    // Which incident tetrahedra share a copy: the library's rule (the Cutter's).
+    std::vector<StarCell>     star;
+    std::vector<unsigned int> group;
     for (const auto &[v, list] : incident)
     {
-      std::vector<std::size_t> parent(list.size());
-      std::iota(parent.begin(), parent.end(), 0);
-      const auto find = [&](std::size_t i)
+      star.clear();
+      for (const std::size_t k : list)
+        star.push_back(
+          {{tets[k][0], tets[k][1], tets[k][2], tets[k][3]}, tet_cut_faces[k]});
+      const unsigned int         n_groups = separate_star(v, star, group);
+      std::vector<std::uint32_t> copy(n_groups, v);
+      for (unsigned int g = 1; g < n_groups; ++g)
       {
-        while (parent[i] != i)
-          i = parent[i] = parent[parent[i]];
-        return i;
-      };
-      std::map<std::array<std::uint32_t, 3>, std::size_t> first_with_face;
-      for (std::size_t i = 0; i < list.size(); ++i)
-      {
-        const auto &t = tets[list[i]];
-        for (unsigned f = 0; f < 4; ++f)
-        {
-          const auto face = sorted(t[(f + 1) % 4], t[(f + 2) % 4], t[(f + 3) % 4]);
-          if (std::find(face.begin(), face.end(), v) == face.end()
-              || cut_faces.count(face))
-            continue;
-          const auto [it, inserted] = first_with_face.emplace(face, i);
-          if (!inserted)
-            parent[find(i)] = find(it->second);
-        }
+        copy[g] = static_cast<std::uint32_t>(points.size());
+        points.push_back(points[v]);
+        mesh.on_surface.push_back(true);
       }
-      std::map<std::size_t, std::uint32_t> copy_of_root;
       for (std::size_t i = 0; i < list.size(); ++i)
-      {
-        const std::size_t root = find(i);
-        if (copy_of_root.empty())
-          copy_of_root[root] = v;
-        auto it = copy_of_root.find(root);
-        if (it == copy_of_root.end())
-        {
-          it =
-            copy_of_root.emplace(root, static_cast<std::uint32_t>(points.size())).first;
-          points.push_back(points[v]);
-          mesh.on_surface.push_back(true);
-        }
         for (auto &node : tets[list[i]])
           if (node == v)
-            node = it->second;
-      }
+            node = copy[group[i]];
     }
     mesh.tets = std::move(tets);
     return stats;
@@ -712,7 +667,8 @@ namespace lacerta::cut::test_support
 
   /**
    * Moves @p cutter's blade through @p path in @p steps equal steps per segment,
-   * calling @p after_step(segment, step) after each; stops when it returns false.
+   * calling @p after_step(segment, step, statistics of the step) after each; stops
+   * when it returns false.
    */
   template <typename Function>
   void
@@ -724,10 +680,11 @@ namespace lacerta::cut::test_support
     for (std::size_t k = 0; k + 1 < path.size(); ++k)
       for (unsigned int s = 1; s <= steps; ++s)
       {
-        const double f = double(s) / steps;
-        cutter.move_blade({lerp(path[k].tail, path[k + 1].tail, f),
-                           lerp(path[k].head, path[k + 1].head, f)});
-        if (!after_step(k, s))
+        const double            f = double(s) / steps;
+        const CutStepStatistics statistics =
+          cutter.move_blade({lerp(path[k].tail, path[k + 1].tail, f),
+                             lerp(path[k].head, path[k + 1].head, f)});
+        if (!after_step(k, s, statistics))
           return;
       }
   }

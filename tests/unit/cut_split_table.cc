@@ -83,7 +83,7 @@ namespace
     double                            sum = 0;
     for (unsigned c = 0; c < r.n_children; ++c)
     {
-      child[c]       = child_points(cut, r, r.children[c]);
+      child[c]       = child_node_points(cut, r, r.children[c]);
       const double v = volume(child[c][0], child[c][1], child[c][2], child[c][3]);
       if (!(v > 1e-9 * V))
         return "child " + std::to_string(c) + " not positively oriented";

@@ -82,7 +82,9 @@ namespace lacerta
         cut::test_support::stroke(*cutter,
                                   path,
                                   steps,
-                                  [](std::size_t, unsigned int) { return true; });
+                                  [](std::size_t,
+                                     unsigned int,
+                                     const cut::CutStepStatistics &) { return true; });
       }
     };
 

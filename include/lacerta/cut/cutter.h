@@ -7,12 +7,15 @@
 
 #include <lacerta/cut/boundary_face_tree.h>
 #include <lacerta/cut/cut_record.h>
+#include <lacerta/cut/cut_rules.h>
 #include <lacerta/cut/split_table.h>
 #include <lacerta/cut/tool.h>
 #include <lacerta/mesh/tet_mesh.h>
 
 #include <deal.II/base/parameter_handler.h>
 
+#include <array>
+#include <cstdint>
 #include <vector>
 
 namespace dealii
@@ -46,6 +49,13 @@ namespace lacerta::cut
     double update_seconds = 0, reinit_seconds = 0;
     /// Whether the mesh changed (then the integrator must be re-initialised).
     bool changed = false;
+    /**
+     * Particles duplicated along the cut surface, as (original, copy), in the order
+     * made (a copy can be copied again later). A copy starts with its original's
+     * state and `free` flag; whoever holds particle lists (the scene's constraints)
+     * extends them so that a fixed particle stays fixed and a handle keeps pulling.
+     */
+    std::vector<std::array<unsigned int, 2>> copied_particles;
   };
 
   /**
@@ -130,6 +140,64 @@ namespace lacerta::cut
     }
 
   private:
+    /// The cut surface of one sweep (deformed configuration): the plane through the
+    /// last crack front along the motion, bounded by the new front.
+    struct SweepSurface
+    {
+      Point origin{}, normal{}, motion{}, start_dir{}, front_dir{}, end_tail{};
+
+      /// Signed distance from the plane.
+      double
+      distance(const Point &x) const
+      {
+        return dot(normal, sub(x, origin));
+      }
+
+      /// Negative behind the new front (where the crack is).
+      double
+      behind(const Point &x) const
+      {
+        return dot(front_dir, sub(x, end_tail));
+      }
+
+      /// How far ahead of the sweep's start line (the last front), in the plane.
+      double
+      ahead_of_start(const Point &x) const
+      {
+        return dot(start_dir, sub(x, origin));
+      }
+    };
+
+    /// Per-vertex scratch of the analysis, valid where `stamp` is the current one.
+    struct VertexScratch
+    {
+      unsigned int stamp = 0, star_stamp = 0;
+      /// Union-find parent (a vertex id) of the patch of on-plane vertices.
+      unsigned int parent   = 0;
+      double       d        = 0;
+      bool         on_plane = false, reached = false, group_reached = false;
+      std::int8_t  side = 0;
+    };
+
+    /// Per-edge scratch: crossing, cut parameter, and the new particles on the edge
+    /// (one per side -1, 0, +1) while children are made.
+    struct EdgeScratch
+    {
+      unsigned int                stamp = 0, point_stamp = 0;
+      bool                        crossing = false, reached = false;
+      double                      t = 0;
+      std::array<unsigned int, 3> point{};
+    };
+
+    /// Per-face-slot (4 t + f) scratch: the front point and its particle.
+    struct FaceScratch
+    {
+      unsigned int stamp = 0, point_stamp = 0;
+      bool         has_front = false;
+      Point        rest{}, now{};
+      unsigned int point = 0;
+    };
+
     /// One sweep from the last applied crack front to @p end.
     void
     sweep(const Blade &end, CutStepStatistics &statistics);
@@ -154,6 +222,43 @@ namespace lacerta::cut
     void
     end_stroke();
 
+    /// Grows the scratch arrays to the mesh (new entries are invalid).
+    void
+    prepare_scratch();
+
+    /// The scratch of vertex @p v, computed for @p surface if not yet in this pass.
+    VertexScratch &
+    vertex_data(unsigned int v, const SweepSurface &surface);
+
+    /// Sides, cut edges and front points on `affected`, closed under what must be
+    /// split alike; false if the closure did not converge (the sweep is postponed).
+    bool
+    analyse(const SweepSurface &surface);
+
+    /// The front point of face @p f of tetrahedron @p t, into @p fs.
+    void
+    compute_front_point(unsigned int        t,
+                        unsigned int        f,
+                        const SweepSurface &surface,
+                        FaceScratch        &fs);
+
+    /// Whether tetrahedron @p t has a cut edge or a front face in the analysis.
+    bool
+    tet_is_cut(unsigned int t) const;
+
+    /// Whether a child of the split is flat at rest.
+    bool
+    has_flat_child(const TetCut &cut, const SplitResult &result) const;
+
+    /// Replaces `removed` by the children of `results`, copies the vertices on the
+    /// cut, updates masses, springs and the active set.
+    void
+    apply(const Blade &end, CutStepStatistics &statistics);
+
+    /// Vertex @p v lies on the cut of the current stroke.
+    void
+    mark_on_surface(unsigned int v);
+
     mesh::TetMesh                     &mesh;
     physics::ParticleSystem           &system;
     const dealii::Function<3, double> &density;
@@ -165,8 +270,12 @@ namespace lacerta::cut
     Blade front;
     /// Typical edge length at rest (median), for the sub-division when nothing is active.
     double typical_edge = 0;
-    /// Consecutive postponed sweeps.
-    unsigned int n_postponed = 0;
+    /// The current stroke (from entering the tissue to leaving it), from 1, and
+    /// whether it has cut anything yet.
+    unsigned int stroke         = 1;
+    bool         stroke_has_cut = false;
+    /// How far behind its start line the current sweep's plane cuts.
+    double start_reach = 0;
 
     BoundaryFaceTree          tree;
     std::vector<unsigned int> active, next_active, candidates, queue;
@@ -176,7 +285,34 @@ namespace lacerta::cut
     std::vector<std::uint8_t>           on_surface;
     std::vector<unsigned int>           on_surface_list;
     std::vector<BoundaryFaceTree::Face> hits;
+    /// Stroke in which a vertex on the plane was swept by the blade (its patch opens
+    /// when all of it is swept).
+    std::vector<unsigned int> swept;
+    /// Stroke in which a tetrahedron was made by a partial split (not split partially
+    /// again while the front is inside it).
+    std::vector<unsigned int> partial_child;
+
+    // Scratch, kept between sweeps so that no sweep allocates or clears O(mesh).
+    std::vector<VertexScratch> vertex_scratch;
+    std::vector<EdgeScratch>   edge_scratch;
+    std::vector<FaceScratch>   face_scratch;
+    std::vector<unsigned int>  tet_mark;
+    unsigned int analysis_stamp = 0, star_stamp = 0, affected_stamp = 0, merge_stamp = 0;
+    std::vector<unsigned int> affected, verts, edge_list, group, group_extra, missing,
+      around, removed, added_ids, touched_vertices, star_group, copy_ids;
+    std::vector<TetCut>                                         cuts;
+    std::vector<SplitResult>                                    results;
+    std::vector<mesh::Tet>                                      children;
+    std::vector<std::uint8_t>                                   child_cut_faces;
+    std::vector<bool>                                           child_partial;
+    std::vector<std::array<unsigned int, 4>>                    face_ids;
+    std::vector<std::array<unsigned int, 2>>                    incidences;
+    std::vector<StarCell>                                       star;
+    std::vector<std::pair<std::array<unsigned int, 2>, double>> stiffness_delta;
+    mesh::TetMesh::EdgeUpdate                                   edge_update;
     /// Where sweeps are recorded (set_recorder()), or nullptr.
     std::vector<CutRecord> *recorder = nullptr;
+    /// Per child of the sweep being applied, when recording: (split, child of the split).
+    std::vector<std::array<unsigned int, 2>> child_origin;
   };
 } // namespace lacerta::cut

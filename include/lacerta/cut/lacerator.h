@@ -12,6 +12,7 @@
 
 #include <deal.II/base/parameter_handler.h>
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -48,6 +49,9 @@ namespace lacerta::cut
     double update_seconds = 0;
     /// Whether the mesh changed (then the integrator must be re-initialised).
     bool changed = false;
+    /// Particles the tear copied along its surface, (original, copy): constraints
+    /// take over the copies of their particles (Scene::follow_cut()).
+    std::vector<std::array<unsigned int, 2>> copied_particles;
   };
 
   /**

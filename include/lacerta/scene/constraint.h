@@ -8,6 +8,7 @@
 #include <lacerta/base/plugins.h>
 #include <lacerta/mesh/tet_mesh.h>
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -52,6 +53,16 @@ namespace lacerta::scene
     virtual void
     initialize(const std::vector<unsigned int> &particles,
                physics::ParticleSystem         &system);
+
+    /**
+     * Extends the constraint to the particles a cut copied from its own (@p copies:
+     * (original, copy) in the order made, so copies of copies follow) and initialises
+     * it again, since the cut changed the masses: a fixed particle's copy stays fixed,
+     * a handle keeps pulling all of its tissue.
+     */
+    void
+    follow_copies(const std::vector<std::array<unsigned int, 2>> &copies,
+                  physics::ParticleSystem                        &system);
 
     /// Whether the constraint prescribes the motion of its particles.
     virtual bool

@@ -10,6 +10,7 @@
 #include <lacerta/scene/constraint.h>
 #include <lacerta/scene/material.h>
 
+#include <array>
 #include <memory>
 #include <ostream>
 #include <vector>
@@ -71,6 +72,13 @@ namespace lacerta::scene
     /// Recomputes the external forces at time @p t (only if some load varies).
     void
     update_loads(double t);
+
+    /**
+     * After a cut: the constraints take over the particles copied from theirs
+     * (@p copies, CutStepStatistics::copied_particles) and follow the new masses.
+     */
+    void
+    follow_cut(const std::vector<std::array<unsigned int, 2>> &copies);
 
     /// Writes a description of the scene (sizes, mass, stiffness range, constraints).
     void
