@@ -581,19 +581,19 @@ namespace lacerta
                 << " steps that cut): MS " << scene->active_mesh().n_tets() << ", CuT "
                 << (cutting_steps ? sum_cut / cutting_steps : 0.0) << ", CrT "
                 << (cutting_steps ? sum_created / cutting_steps : 0.0);
+      if (!test_mode && cutting_steps > 0)
+        std::cout << ", UpdT " << 1e3 * sum_update / cutting_steps << " ms, RxT "
+                  << 1e3 * sum_relax / cutting_steps << " ms";
       if (scene->multiresolution)
-        std::cout << "; " << n_mt_updates << " MT updates (Table 2 columns, totals): SF "
+        std::cout << "; " << n_mt_updates
+                  << " MT updates (Table 2 columns: totals, times per stroke): SF "
                   << total_split_fragments << ", MT tetrahedra cut " << total_mt_cut
                   << ", created " << total_mt_created
                   << (scene->cut_pending() ? " (a stroke still waits for its update)"
                                            : "");
       if (!test_mode && n_mt_updates > 0)
         std::cout << ", TetUp " << 1e3 * total_tet_update / n_mt_updates
-                  << " ms, MT-DAGUpd " << 1e3 * total_mt_update / n_mt_updates
-                  << " ms per stroke";
-      if (!test_mode && cutting_steps > 0)
-        std::cout << ", UpdT " << 1e3 * sum_update / cutting_steps << " ms, RxT "
-                  << 1e3 * sum_relax / cutting_steps << " ms";
+                  << " ms, MT-DAGUpd " << 1e3 * total_mt_update / n_mt_updates << " ms";
       std::cout << "; mesh components " << cut::count_components(scene->active_mesh())
                 << "\n";
     }
