@@ -138,6 +138,18 @@ namespace lacerta::mt
   }
 
 
+  MtCutter::Statistics
+  Multiresolution::apply_cut(const std::vector<cut::CutRecord> &records,
+                             const double                       snap_fraction)
+  {
+    if (!mt_cutter)
+      mt_cutter = std::make_unique<MtCutter>(mt, snap_fraction);
+    const MtCutter::Statistics statistics = mt_cutter->apply(records, lod.get());
+    make_active_mesh();
+    return statistics;
+  }
+
+
   void
   Multiresolution::make_active_mesh()
   {

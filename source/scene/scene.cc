@@ -1,5 +1,6 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/cut/cutter.h>
+#include <lacerta/cut/invariants.h>
 #include <lacerta/cut/lacerator.h>
 #include <lacerta/cut/tool.h>
 #include <lacerta/mesh/mesh_source.h>
@@ -65,16 +66,17 @@ namespace lacerta::scene
     cutter_parameters = cut::Cutter::parse_parameters(prm);
     if (tool)
     {
-      if (multiresolution)
-        throw_error("Tool/Type: cuts on the multiresolution model are not available yet; "
-                    "set 'Multiresolution/Enabled = false' or 'Tool/Type = none'.");
-      cutter = std::make_unique<cut::Cutter>(mesh,
+      // On a multiresolution model the cutter cuts the level of detail at once; its
+      // records update the MT once the stroke is over (doc/mt-cutting.md).
+      cutter = std::make_unique<cut::Cutter>(mesh_to_cut(),
                                              *system,
                                              material.density(),
                                              material.youngs_modulus(),
                                              integral_of_density,
                                              cutter_parameters,
                                              tool->blade(0.0));
+      if (multiresolution)
+        cutter->set_recorder(&cut_records);
     }
     if (cut::Lacerator::enabled(prm))
     {
@@ -101,13 +103,47 @@ namespace lacerta::scene
       return;
     const cut::Blade blade = cutter->blade();
     cutter.reset();
-    cutter = std::make_unique<cut::Cutter>(mesh,
+    cutter = std::make_unique<cut::Cutter>(mesh_to_cut(),
                                            *system,
                                            material.density(),
                                            material.youngs_modulus(),
                                            integral_of_density,
                                            cutter_parameters,
                                            blade);
+    if (multiresolution)
+      cutter->set_recorder(&cut_records);
+  }
+
+
+  mesh::TetMesh &
+  Scene::mesh_to_cut()
+  {
+    return multiresolution ? multiresolution->mesh_to_cut() : mesh;
+  }
+
+
+  std::optional<Scene::MultiresolutionCut>
+  Scene::update_multiresolution_after_cut(const double t)
+  {
+    if (!multiresolution || !cutter || cut_records.empty()
+        || !cutter->active_tets().empty())
+      return std::nullopt;
+    // The cutter's mesh and state, before the level of detail is replaced.
+    const mesh::TetMesh       cut_mesh = multiresolution->active_mesh();
+    const std::vector<double> old_x = system->position, old_v = system->velocity;
+    MultiresolutionCut        result;
+    result.pieces_before = cut::count_components(cut_mesh);
+    result.update =
+      multiresolution->apply_cut(cut_records, cutter_parameters.snap_fraction);
+    cut_records.clear();
+    assemble(multiresolution->active_mesh(), t);
+    result.transfer = mt::transfer_state_across_cut(
+      cut_mesh, old_x, old_v, active_mesh(), system->position, system->velocity);
+    system->enforce_constraints(t, system->position.data(), system->velocity.data());
+    system->update_force_model(n_threads);
+    result.pieces_after = cut::count_components(active_mesh());
+    restart_cutter();
+    return result;
   }
 
 
@@ -129,6 +165,7 @@ namespace lacerta::scene
     system->mass = physics::compute_masses(active, material.density());
     if (&active != &mesh)
     {
+      level_of_detail_volume = active.total_volume();
       // A coarser boundary covers a slightly different volume; the total mass stays
       // the integral of the density over the object (Section 3.1).
       const double total = std::accumulate(system->mass.begin(), system->mass.end(), 0.0);
@@ -187,7 +224,9 @@ namespace lacerta::scene
                                 const unsigned int step,
                                 std::ostream      &out)
   {
-    if (!multiresolution)
+    // While a cut waits for its MT update the level of detail is the cutter's mesh,
+    // whose new particles the MT does not know yet: re-extraction waits for the update.
+    if (!multiresolution || cut_pending())
       return false;
     const std::vector<std::uint32_t> old_vertices = multiresolution->active_vertices();
     if (!multiresolution->update(t, step))
@@ -198,6 +237,7 @@ namespace lacerta::scene
       old_vertices, old_x, old_v, system->position, system->velocity);
     system->enforce_constraints(t, system->position.data(), system->velocity.data());
     system->update_force_model(n_threads);
+    restart_cutter();
     multiresolution->print_change(
       out, t, std::accumulate(system->mass.begin(), system->mass.end(), 0.0));
     return true;

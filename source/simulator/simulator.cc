@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <numeric>
 #include <unistd.h>
 
 namespace lacerta
@@ -333,20 +334,27 @@ namespace lacerta
     {
       if (!check_invariants)
         return;
-      const std::string problem = cut::check_invariants(scene->mesh,
+      const std::string problem = cut::check_invariants(scene->active_mesh(),
                                                         system,
-                                                        scene->initial_volume,
+                                                        scene->expected_volume(),
                                                         scene->integral_of_density);
       if (!problem.empty())
         throw_error("Check invariants: after step ", step, ": ", problem, ".");
     };
     check(0);
     // The paper's Table 1, averaged over the steps that cut.
-    unsigned int          cutting_steps      = 0;
-    unsigned long long    n_integrator_steps = 0;
-    double                sum_cut = 0, sum_created = 0, sum_update = 0, sum_relax = 0;
-    unsigned int          n_tears = 0, n_torn = 0, n_tear_created = 0;
-    double                sum_tear = 0;
+    unsigned int       cutting_steps      = 0;
+    unsigned long long n_integrator_steps = 0;
+    double             sum_cut = 0, sum_created = 0, sum_update = 0, sum_relax = 0;
+    unsigned int       n_tears = 0, n_torn = 0, n_tear_created = 0;
+    double             sum_tear = 0;
+    // The paper's Table 2 on a multiresolution model: the cutter's work on the level of
+    // detail during a stroke (CuT, CrT, TetUp), then the MT update after it (SF,
+    // MT-DAGUpd); per stroke and summed over the run.
+    unsigned int stroke_cut = 0, stroke_created = 0, n_mt_updates = 0;
+    double       stroke_update         = 0;
+    unsigned int total_split_fragments = 0, total_mt_cut = 0, total_mt_created = 0;
+    double       total_tet_update = 0, total_mt_update = 0;
     postprocess::RunState state;
     state.mesh     = &scene->active_mesh();
     state.system   = &system;
@@ -400,6 +408,8 @@ namespace lacerta
       state.update_seconds                = 0;
       state.over_limit = state.tears = state.torn_tets = state.tear_created_tets = 0;
       state.tear_seconds                                                         = 0;
+      state.split_fragments                                                      = 0;
+      state.mt_update_seconds                                                    = 0;
       bool cut_changed                                                           = false;
       if (scene->cutter)
       {
@@ -410,6 +420,9 @@ namespace lacerta
         state.created_tets   = cut.created_tets;
         state.update_seconds = cut.update_seconds;
         cut_changed          = cut.changed;
+        stroke_cut += cut.cut_tets;
+        stroke_created += cut.created_tets;
+        stroke_update += cut.update_seconds;
         if (cut.changed)
         {
           // New particles and springs: the constraints take over the copies of
@@ -485,6 +498,42 @@ namespace lacerta
         sum_relax += seconds_since(relax_start);
       }
       time = (step == n_steps) ? end_time : time + dt;
+      if (const auto mt_cut = scene->update_multiresolution_after_cut(time))
+      {
+        // The simulation moves to the MT's version of the cut level of detail: new
+        // particles and springs, as after a re-extraction.
+        ++n_mt_updates;
+        state.split_fragments   = mt_cut->update.split_fragments;
+        state.mt_update_seconds = mt_cut->update.seconds;
+        total_split_fragments += mt_cut->update.split_fragments;
+        total_mt_cut += mt_cut->update.cut_tets;
+        total_mt_created += mt_cut->update.created_tets;
+        total_tet_update += stroke_update;
+        total_mt_update += mt_cut->update.seconds;
+        std::cout << "MT update after the stroke at t = " << time << " s: SF "
+                  << mt_cut->update.split_fragments << ", CuT " << stroke_cut << ", CrT "
+                  << stroke_created;
+        if (!test_mode)
+          std::cout << ", TetUp " << 1e3 * stroke_update << " ms, MT-DAGUpd "
+                    << 1e3 * mt_cut->update.seconds << " ms";
+        std::cout << "; MT tetrahedra cut " << mt_cut->update.cut_tets << ", created "
+                  << mt_cut->update.created_tets << ", vertices added "
+                  << mt_cut->update.new_vertices << "; level of detail "
+                  << scene->active_mesh().n_tets() << " tetrahedra, "
+                  << system.n_particles() << " particles (" << mt_cut->transfer.copied
+                  << " copied, " << mt_cut->transfer.interpolated
+                  << " interpolated), mass "
+                  << std::accumulate(system.mass.begin(), system.mass.end(), 0.0)
+                  << " kg; mesh components " << mt_cut->pieces_after
+                  << " (the cutter's mesh had " << mt_cut->pieces_before << ")\n";
+        stroke_cut = stroke_created = 0;
+        stroke_update               = 0;
+        check(step);
+        integrator->initialize(system);
+        substeps = state.substeps = choose_substeps();
+        monitor                   = physics::BlowUpMonitor(system, energy_tolerance);
+        state.mesh                = &scene->active_mesh();
+      }
       if (scene->update_level_of_detail(time, step, std::cout))
       {
         // Other particles and springs: new scratch space, stability limit and energy
@@ -533,14 +582,24 @@ namespace lacerta
     if (scene->cutter)
     {
       std::cout << "Cut summary (Table 1 columns, averages over the " << cutting_steps
-                << " steps that cut): MS " << scene->mesh.n_tets() << ", CuT "
+                << " steps that cut): MS " << scene->active_mesh().n_tets() << ", CuT "
                 << (cutting_steps ? sum_cut / cutting_steps : 0.0) << ", CrT "
                 << (cutting_steps ? sum_created / cutting_steps : 0.0);
       if (!test_mode && cutting_steps > 0)
         std::cout << ", UpdT " << 1e3 * sum_update / cutting_steps << " ms, RxT "
                   << 1e3 * sum_relax / cutting_steps << " ms";
+      if (scene->multiresolution)
+        std::cout << "; " << n_mt_updates
+                  << " MT updates (Table 2 columns: totals, times per stroke): SF "
+                  << total_split_fragments << ", MT tetrahedra cut " << total_mt_cut
+                  << ", created " << total_mt_created
+                  << (scene->cut_pending() ? " (a stroke still waits for its update)"
+                                           : "");
+      if (!test_mode && n_mt_updates > 0)
+        std::cout << ", TetUp " << 1e3 * total_tet_update / n_mt_updates
+                  << " ms, MT-DAGUpd " << 1e3 * total_mt_update / n_mt_updates << " ms";
       // The pieces' rest volumes show what a cut separated (a punched hole).
-      const std::vector<double> pieces = cut::component_volumes(scene->mesh);
+      const std::vector<double> pieces = cut::component_volumes(scene->active_mesh());
       std::cout << "; mesh components " << pieces.size() << ", rest volumes (m^3)";
       for (const double v : pieces)
         std::cout << " " << v;

@@ -5,9 +5,11 @@
  */
 #pragma once
 
+#include <lacerta/cut/cut_record.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/mt/lod.h>
 #include <lacerta/mt/lod_query.h>
+#include <lacerta/mt/mt_cutter.h>
 #include <lacerta/mt/multi_triangulation.h>
 #include <lacerta/mt/storage.h>
 
@@ -68,6 +70,27 @@ namespace lacerta::mt
       return mesh;
     }
 
+    /**
+     * The mesh of the current level of detail, for the Cutter to cut in place. Once
+     * cut, its new particles have no MT vertex id (active_vertices() lists the first
+     * ones only) until apply_cut() replaces it; update() must not be called between.
+     */
+    mesh::TetMesh &
+    mesh_to_cut()
+    {
+      return mesh;
+    }
+
+    /**
+     * Splits the MT along the rest cut surface of @p records (made by a Cutter on
+     * mesh_to_cut(), in order, snapping with @p snap_fraction) and makes the level of
+     * detail the MT's version of the cut one (doc/mt-cutting.md); active_mesh() is then
+     * rebuilt from it. The index of the MT's tetrahedra is built at the first call.
+     * Returns the MT columns of the paper's Table 2.
+     */
+    MtCutter::Statistics
+    apply_cut(const std::vector<cut::CutRecord> &records, double snap_fraction);
+
     /// The MT vertex id of every vertex of active_mesh(), increasing.
     const std::vector<std::uint32_t> &
     active_vertices() const
@@ -116,6 +139,7 @@ namespace lacerta::mt
     make_active_mesh();
 
     MultiTriangulation                         mt;
+    std::unique_ptr<MtCutter>                  mt_cutter;
     CacheReport                                cache;
     std::unique_ptr<Lod>                       lod;
     std::unique_ptr<LodQuery>                  query;

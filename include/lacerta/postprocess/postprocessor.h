@@ -53,6 +53,10 @@ namespace lacerta::postprocess
     /// scene without lacerations.
     unsigned int over_limit = 0, tears = 0, torn_tets = 0, tear_created_tets = 0;
     double       tear_seconds = 0;
+    /// The MT update after a stroke on a multiresolution model (the paper's Table 2):
+    /// fragments split (SF) and its wall time (MT-DAGUpd, s); zero at other steps.
+    unsigned int split_fragments   = 0;
+    double       mt_update_seconds = 0;
   };
 
 

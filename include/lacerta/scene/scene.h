@@ -6,12 +6,15 @@
 
 #include <lacerta/cut/cutter.h>
 #include <lacerta/mesh/tet_mesh.h>
+#include <lacerta/mt/cut_state_transfer.h>
+#include <lacerta/mt/mt_cutter.h>
 #include <lacerta/scene/body_force.h>
 #include <lacerta/scene/constraint.h>
 #include <lacerta/scene/material.h>
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <vector>
 
@@ -59,11 +62,54 @@ namespace lacerta::scene
     /**
      * With multiresolution: re-extracts the level of detail if the focus at time @p t
      * (step @p step) asks for it and, if it changed, rebuilds the particle system on it
-     * with the particles' state carried over (Section 4.2), writing a line to @p out.
-     * Returns whether the particle system changed; without multiresolution, false.
+     * with the particles' state carried over (Section 4.2), writing a line to @p out;
+     * the cutter, if any, restarts on it. Postponed while a cut waits for its MT
+     * update (update_multiresolution_after_cut()). Returns whether the particle system
+     * changed; without multiresolution, false.
      */
     bool
     update_level_of_detail(double t, unsigned int step, std::ostream &out);
+
+    /// What update_multiresolution_after_cut() did.
+    struct MultiresolutionCut
+    {
+      /// The MT update (SF, MT tetrahedra cut and created, MT-DAGUpd).
+      mt::MtCutter::Statistics update;
+      /// How the particles' state reached the MT's version of the cut level of detail.
+      mt::CutTransferReport transfer;
+      /// Connected pieces of the cutter's mesh before the switch and of the MT's
+      /// version after it (they differ where the MT update left a bridge).
+      unsigned int pieces_before = 0, pieces_after = 0;
+    };
+
+    /**
+     * With multiresolution and a tool: once the stroke is over (the blade is in no
+     * tetrahedron) and the cutter has cut the level of detail since the last call,
+     * updates the MT with the cutter's records, rebuilds the particle system on the
+     * MT's version of the cut level of detail at time @p t (state carried over by
+     * mt::transfer_state_across_cut(), masses scaled to ∫σ, constraints applied to
+     * the particles in their regions) and restarts the cutter on it. Returns what it
+     * did, or nothing if there was nothing to do.
+     */
+    std::optional<MultiresolutionCut>
+    update_multiresolution_after_cut(double t);
+
+    /// Whether a cut on the multiresolution model waits for its MT update.
+    bool
+    cut_pending() const
+    {
+      return !cut_records.empty();
+    }
+
+    /**
+     * The volume the active mesh must have: the mesh's as built, or with
+     * multiresolution the level of detail's when it was extracted (cuts conserve it).
+     */
+    double
+    expected_volume() const
+    {
+      return multiresolution ? level_of_detail_volume : initial_volume;
+    }
 
     /// The mesh the particle system lives on: the level of detail, or the mesh.
     const mesh::TetMesh &
@@ -124,6 +170,14 @@ namespace lacerta::scene
     void
     assemble(const mesh::TetMesh &active, double t);
 
+    /// The mesh the cutter cuts: the level of detail's, or the mesh.
+    mesh::TetMesh &
+    mesh_to_cut();
+
+    /// The records of the cutter's sweeps since the last MT update (multiresolution).
+    std::vector<cut::CutRecord> cut_records;
+    /// Volume of the level of detail when it was last assembled.
+    double level_of_detail_volume = 0;
     /// The parameters of `subsection Cut`, for restart_cutter().
     cut::Cutter::Parameters cutter_parameters;
     bool                    has_varying_loads = false;
