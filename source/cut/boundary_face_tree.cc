@@ -62,7 +62,6 @@ namespace lacerta::cut
       faces.push_back(make_face(mesh, bf.tet, bf.face));
     if (!faces.empty())
       build_node(0, static_cast<unsigned int>(faces.size()), x);
-    last_positions = x;
   }
 
 
@@ -111,7 +110,6 @@ namespace lacerta::cut
       build(mesh, x);
       return;
     }
-    last_positions = x;
     // Children always come after their parent: one backward sweep refits the tree.
     for (std::size_t i = nodes.size(); i-- > 0;)
     {
@@ -140,10 +138,10 @@ namespace lacerta::cut
 
   void
   BoundaryFaceTree::query(const mesh::TetMesh &mesh,
+                          const double        *x,
                           const Box           &box,
                           std::vector<Face>   &hits) const
   {
-    const double *x = last_positions;
     if (!nodes.empty())
     {
       unsigned int stack[64];

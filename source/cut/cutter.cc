@@ -202,7 +202,7 @@ namespace lacerta::cut
       for (const Point &p : tri)
         box.extend(p);
     hits.clear();
-    tree.query(mesh, box, hits);
+    tree.query(mesh, system.position.data(), box, hits);
     for (const auto &f : hits)
     {
       const auto tri = BoundaryFaceTree::triangle(f, system.position.data());

@@ -48,11 +48,16 @@ namespace lacerta::cut
     add_face(const mesh::TetMesh &mesh, unsigned int tet, unsigned int face);
 
     /**
-     * Appends to @p hits the boundary faces whose box overlaps @p box and that are still
-     * boundary faces of @p mesh.
+     * Appends to @p hits the boundary faces whose box at positions @p x overlaps @p box
+     * and that are still boundary faces of @p mesh. The tree's inner boxes are those of
+     * the last build or refit; @p x are the current positions (3 per vertex), passed
+     * every time because the array may have moved since (a cut appends particles).
      */
     void
-    query(const mesh::TetMesh &mesh, const Box &box, std::vector<Face> &hits) const;
+    query(const mesh::TetMesh &mesh,
+          const double        *x,
+          const Box           &box,
+          std::vector<Face>   &hits) const;
 
     /// Number of faces in the tree and the pending list.
     std::size_t
@@ -82,6 +87,5 @@ namespace lacerta::cut
     std::vector<Face> faces;
     std::vector<Face> extra;
     std::vector<Node> nodes;
-    const double     *last_positions = nullptr;
   };
 } // namespace lacerta::cut
