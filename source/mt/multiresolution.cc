@@ -1,6 +1,7 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/parameter_utilities.h>
 #include <lacerta/base/parsed_function.h>
+#include <lacerta/mt/cut_state_transfer.h>
 #include <lacerta/mt/multiresolution.h>
 
 #include <deal.II/base/function_parser.h>
@@ -154,7 +155,9 @@ namespace lacerta::mt
   Multiresolution::make_active_mesh()
   {
     vertices = lod->active_vertices();
-    mesh     = lod->make_mesh(vertices, "level of detail");
+    if (!mt.cut_origin.empty())
+      previous_mesh = std::move(mesh);
+    mesh = lod->make_mesh(vertices, "level of detail");
   }
 
 
@@ -173,6 +176,17 @@ namespace lacerta::mt
                : static_cast<std::size_t>(-1);
     };
     n_kept = n_new = 0;
+    if (!mt.cut_origin.empty())
+    {
+      // A cut MT: the walk of locate_in_previous() may end in a tetrahedron across the
+      // opened cut, whose particles have moved apart; the geometric transfer picks the
+      // tetrahedron on the vertex's own side.
+      const CutTransferReport report =
+        transfer_state_across_cut(previous_mesh, old_x, old_v, mesh, x, v);
+      n_kept = report.copied;
+      n_new  = report.interpolated;
+      return;
+    }
     for (std::size_t i = 0; i < vertices.size(); ++i)
     {
       const std::size_t o = old_index(vertices[i]);

@@ -104,7 +104,9 @@ namespace lacerta::mt
      * @p old_vertices: vertices kept keep their state, new ones get the state
      * interpolated in the previous level's tetrahedron that contains them
      * (Lod::locate_in_previous), with barycentric coordinates clamped to the
-     * tetrahedron.
+     * tetrahedron. Once the MT has been cut, new vertices are located geometrically in
+     * the previous level's tetrahedron on their side of the cut
+     * (transfer_state_across_cut()).
      */
     void
     transfer_state(const std::vector<std::uint32_t> &old_vertices,
@@ -149,7 +151,10 @@ namespace lacerta::mt
     mesh::Point3                               last_focus{};
     unsigned int                               last_step = 0;
     mesh::TetMesh                              mesh;
-    std::vector<std::uint32_t>                 vertices;
-    std::size_t                                n_kept = 0, n_new = 0;
+    /// The level of detail before the last re-extraction, kept once the MT has been
+    /// cut: transfer_state() then locates new vertices geometrically, side by side.
+    mesh::TetMesh              previous_mesh;
+    std::vector<std::uint32_t> vertices;
+    std::size_t                n_kept = 0, n_new = 0;
   };
 } // namespace lacerta::mt
