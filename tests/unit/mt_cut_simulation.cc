@@ -184,5 +184,43 @@ namespace lacerta
     // The scalpel can cut again the mesh it now lives on.
     EXPECT_TRUE(scene->cutter->active_tets().empty());
     EXPECT_EQ(&now, &scene->active_mesh());
+
+    // A later level of detail, the focus moved onto the cut: the particles that appear
+    // next to it get the field of their own side (an MT walk could end across the
+    // opened cut and pull them 4 mm onto the other side). Tolerances: a quarter of the
+    // jump; a few vertices outside the coarse tetrahedron they are interpolated in are
+    // clamped (errors up to 5e-4 m seen).
+    ASSERT_TRUE(scene->update_level_of_detail(0.5, 2000000, std::cout));
+    const mesh::TetMesh   &later       = scene->active_mesh();
+    const std::vector<int> later_sides = sides(later);
+    EXPECT_EQ(cut::count_components(later), 2u);
+    unsigned int n_checked = 0, n_off = 0;
+    for (unsigned int i = 0; i < later.n_vertices(); ++i)
+    {
+      // Near the cut only: far from it the coarse tetrahedra reach the fixed edges,
+      // whose particles are at rest rather than on the field.
+      const mesh::Point3 &r = later.vertex(i);
+      if (std::abs(r[0] - cut_x) > 0.01)
+        continue;
+      ++n_checked;
+      bool off = false;
+      for (unsigned int d = 0; d < 3; ++d)
+        off =
+          off
+          || std::abs(system.position[3 * i + d] - field_x(r, later_sides[i], d)) > 1e-3
+          || std::abs(system.velocity[3 * i + d] - field_v(r, later_sides[i], d)) > 5e-3;
+      if (off)
+      {
+        ++n_off;
+        std::cout << "particle " << i << " at rest (" << r[0] << ", " << r[1] << ", "
+                  << r[2] << ") has not the state of its side\n";
+      }
+    }
+    // The MT walk put 241 of 839 off their side; the geometric transfer leaves two
+    // vertices lying on the cut plane (doc/mt-cutting.md, not done yet).
+    EXPECT_LE(n_off, 2u);
+    std::cout << n_off << " of " << n_checked
+              << " particles near the cut off their side's state\n";
+    EXPECT_GT(n_checked, 100u);
   }
 } // namespace lacerta
