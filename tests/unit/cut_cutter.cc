@@ -205,33 +205,70 @@ TEST(CutCutter, RandomStrokesKeepTheInvariants)
 }
 
 
+namespace
+{
+  /// Volumes of the pieces after a square loop (side 0.4) cut in @p steps steps per
+  /// side through the box of 4^3 cubes, entering from above and lifted out.
+  std::vector<double>
+  punch_square(const unsigned int steps)
+  {
+    std::mt19937 rng(5);
+    // A square loop inside the box, passing its start again: the inside drops out.
+    const std::vector<Blade> loop = {vertical(0.3, 0.3),
+                                     vertical(0.7, 0.3),
+                                     vertical(0.7, 0.7),
+                                     vertical(0.3, 0.7),
+                                     vertical(0.3, 0.25)};
+    // The blade enters from above, runs the loop and is lifted out.
+    const Blade above{{{0.3, 0.3, 2.5}}, {{0.3, 0.3, 1.2}}};
+    const Blade lifted{{{0.3, 0.25, 2.5}}, {{0.3, 0.25, 1.2}}};
+    CutFixture  f(4, rng, above);
+    f.stroke({above, loop[0]}, 4);
+    f.stroke(loop, steps);
+    f.stroke({loop.back(), lifted}, 4);
+    if (::testing::Test::HasFatalFailure())
+      return {};
+    return f.component_volumes();
+  }
+} // namespace
+
+
+namespace
+{
+  /// Expects the pieces of punch_square(@p steps): exactly two, the smaller the
+  /// square's volume.
+  void
+  expect_square_punched(const unsigned int steps)
+  {
+    const auto pieces = punch_square(steps);
+    ASSERT_FALSE(::testing::Test::HasFatalFailure()) << steps << " steps per side";
+    // The square of side 0.4 through the whole height drops out: exactly two pieces,
+    // the smaller the enclosed volume (snapping moves each side by at most ε of an
+    // edge, 0.05 * 0.25, and the crack cuts the corners of the path by less than that).
+    std::string listing;
+    for (const double v : pieces)
+      listing += " " + std::to_string(v);
+    ASSERT_EQ(pieces.size(), 2u) << steps << " steps per side, pieces:" << listing;
+    EXPECT_NEAR(pieces[0], 0.16, 4 * 0.4 * 0.0125) << steps << " steps per side";
+    EXPECT_NEAR(pieces[0] + pieces[1], 1.0, 1e-12) << steps << " steps per side";
+  }
+} // namespace
+
+
 TEST(CutCutter, ClosedLoopPunchesAHole)
 {
-  std::mt19937 rng(5);
-  // A square loop inside the box, passing its start again: the inside drops out.
-  const std::vector<Blade> loop = {vertical(0.3, 0.3),
-                                   vertical(0.7, 0.3),
-                                   vertical(0.7, 0.7),
-                                   vertical(0.3, 0.7),
-                                   vertical(0.3, 0.25)};
-  // The blade enters from above, runs the loop and is lifted out.
-  const Blade above{{{0.3, 0.3, 2.5}}, {{0.3, 0.3, 1.2}}};
-  const Blade lifted{{{0.3, 0.25, 2.5}}, {{0.3, 0.25, 1.2}}};
-  CutFixture  f(4, rng, above);
-  f.stroke({above, loop[0]}, 4);
-  f.stroke(loop, 8);
-  f.stroke({loop.back(), lifted}, 4);
-  ASSERT_FALSE(::testing::Test::HasFatalFailure());
-  const auto pieces = f.component_volumes();
-  // The square of side 0.4 through the whole height drops out: exactly two pieces,
-  // the smaller the enclosed volume (snapping moves each side by at most ε of an
-  // edge, 0.05 * 0.25, and the crack cuts the corners of the path by less than that).
-  std::string listing;
-  for (const double v : pieces)
-    listing += " " + std::to_string(v);
-  ASSERT_EQ(pieces.size(), 2u) << "pieces:" << listing;
-  EXPECT_NEAR(pieces[0], 0.16, 4 * 0.4 * 0.0125);
-  EXPECT_NEAR(pieces[0] + pieces[1], 1.0, 1e-12);
+  expect_square_punched(8);
+}
+
+
+// Documents a limit (doc/cutting.md, "Limits"), disabled because it fails: with finer
+// steps the crack front waits at a corner and cuts it along a chord (20 and 50 steps
+// per side punch 0.1376 and 0.1386), and with 100 the loop does not separate. Run it
+// with --gtest_also_run_disabled_tests once the front follows corners.
+TEST(CutCutter, DISABLED_ClosedLoopPunchesAHoleWithFineSteps)
+{
+  for (const unsigned int steps : {20u, 50u, 100u})
+    expect_square_punched(steps);
 }
 
 
