@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "cut_split_support.h"
+#include "physics_test_support.h"
 #include <functional>
 #include <memory>
 #include <numeric>
@@ -48,14 +49,10 @@ namespace
       std::vector<mesh::Tet>    t;
       for (const auto &c : box.tets)
         t.push_back({{c[0], c[1], c[2], c[3]}});
-      mesh = mesh::TetMesh(x, t, "box");
-      std::vector<double> rest;
-      for (const auto &p : x)
-        rest.insert(rest.end(), p.begin(), p.end());
-      system          = std::make_unique<physics::ParticleSystem>(rest);
-      system->mass    = physics::compute_masses(mesh, density);
-      system->springs = physics::compute_springs(mesh, youngs);
-      system->set_force_model(physics::ForceModelRegistry::create("linear springs"), 1);
+      mesh     = mesh::TetMesh(x, t, "box");
+      system   = test_support::make_system(mesh,
+                                         density.value(dealii::Point<3>()),
+                                         youngs.value(dealii::Point<3>()));
       integral = physics::integrate_over_mesh(mesh, density);
       volume   = mesh.total_volume();
       // A deformed configuration: stretched along y. The blade cuts what it sees.

@@ -15,6 +15,7 @@
 
 #include <gtest/gtest.h>
 
+#include "physics_test_support.h"
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -95,17 +96,12 @@ namespace
                 std::swap(t[0], t[1]);
               tets.push_back(t);
             }
-      mesh = mesh::TetMesh(x, tets, "slab");
-      std::vector<double> rest;
-      for (const auto &p : x)
-        rest.insert(rest.end(), p.begin(), p.end());
-      system          = std::make_unique<physics::ParticleSystem>(rest);
-      system->mass    = physics::compute_masses(mesh, density);
-      system->springs = physics::compute_springs(mesh, youngs);
-      system->set_force_model(physics::ForceModelRegistry::create("linear springs"), 1);
-      system->enforce_constraints = [](double, double *, double *) {};
-      integral                    = physics::integrate_over_mesh(mesh, density);
-      volume                      = mesh.total_volume();
+      mesh     = mesh::TetMesh(x, tets, "slab");
+      system   = test_support::make_system(mesh,
+                                         density.value(dealii::Point<3>()),
+                                         youngs.value(dealii::Point<3>()));
+      integral = physics::integrate_over_mesh(mesh, density);
+      volume   = mesh.total_volume();
       for (unsigned int i = 0; i < system->n_particles(); ++i)
       {
         const Point y = deformation(x[i]);
