@@ -155,8 +155,8 @@ namespace lacerta::mt
   Multiresolution::make_active_mesh()
   {
     vertices = lod->active_vertices();
-    if (!mt.cut_origin.empty())
-      previous_mesh = std::move(mesh);
+    if (mt_cutter)
+      previous = std::move(mesh);
     mesh = lod->make_mesh(vertices, "level of detail");
   }
 
@@ -176,13 +176,13 @@ namespace lacerta::mt
                : static_cast<std::size_t>(-1);
     };
     n_kept = n_new = 0;
-    if (!mt.cut_origin.empty())
+    if (mt_cutter)
     {
       // A cut MT: the walk of locate_in_previous() may end in a tetrahedron across the
       // opened cut, whose particles have moved apart; the geometric transfer picks the
       // tetrahedron on the vertex's own side.
       const CutTransferReport report =
-        transfer_state_across_cut(previous_mesh, old_x, old_v, mesh, x, v);
+        transfer_state_across_cut(previous, old_x, old_v, mesh, x, v);
       n_kept = report.copied;
       n_new  = report.interpolated;
       return;

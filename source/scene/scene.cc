@@ -122,27 +122,42 @@ namespace lacerta::scene
   }
 
 
+  template <typename Transfer>
+  void
+  Scene::move_to_level_of_detail(const double t, const Transfer &transfer)
+  {
+    const std::vector<double> old_x = system->position, old_v = system->velocity;
+    assemble(multiresolution->active_mesh(), t);
+    transfer(old_x, old_v, system->position, system->velocity);
+    system->enforce_constraints(t, system->position.data(), system->velocity.data());
+    system->update_force_model(n_threads);
+    restart_cutter();
+  }
+
+
   std::optional<Scene::MultiresolutionCut>
   Scene::update_multiresolution_after_cut(const double t)
   {
     if (!multiresolution || !cutter || cut_records.empty()
         || !cutter->active_tets().empty())
       return std::nullopt;
-    // The cutter's mesh and state, before the level of detail is replaced.
-    const mesh::TetMesh       cut_mesh = multiresolution->active_mesh();
-    const std::vector<double> old_x = system->position, old_v = system->velocity;
-    MultiresolutionCut        result;
-    result.pieces_before = cut::count_components(cut_mesh);
+    MultiresolutionCut result;
+    result.pieces_before = cut::count_components(multiresolution->active_mesh());
     result.update =
       multiresolution->apply_cut(cut_records, cutter_parameters.snap_fraction);
     cut_records.clear();
-    assemble(multiresolution->active_mesh(), t);
-    result.transfer = mt::transfer_state_across_cut(
-      cut_mesh, old_x, old_v, active_mesh(), system->position, system->velocity);
-    system->enforce_constraints(t, system->position.data(), system->velocity.data());
-    system->update_force_model(n_threads);
+    // The cutter's mesh, which the MT's version of it replaced.
+    const mesh::TetMesh &cut_mesh = multiresolution->previous_mesh();
+    move_to_level_of_detail(t,
+                            [&](const std::vector<double> &old_x,
+                                const std::vector<double> &old_v,
+                                std::vector<double>       &x,
+                                std::vector<double>       &v)
+                            {
+                              result.transfer = mt::transfer_state_across_cut(
+                                cut_mesh, old_x, old_v, active_mesh(), x, v);
+                            });
     result.pieces_after = cut::count_components(active_mesh());
-    restart_cutter();
     return result;
   }
 
@@ -231,13 +246,13 @@ namespace lacerta::scene
     const std::vector<std::uint32_t> old_vertices = multiresolution->active_vertices();
     if (!multiresolution->update(t, step))
       return false;
-    const std::vector<double> old_x = system->position, old_v = system->velocity;
-    assemble(multiresolution->active_mesh(), t);
-    multiresolution->transfer_state(
-      old_vertices, old_x, old_v, system->position, system->velocity);
-    system->enforce_constraints(t, system->position.data(), system->velocity.data());
-    system->update_force_model(n_threads);
-    restart_cutter();
+    move_to_level_of_detail(
+      t,
+      [&](const std::vector<double> &old_x,
+          const std::vector<double> &old_v,
+          std::vector<double>       &x,
+          std::vector<double>       &v)
+      { multiresolution->transfer_state(old_vertices, old_x, old_v, x, v); });
     multiresolution->print_change(
       out, t, std::accumulate(system->mass.begin(), system->mass.end(), 0.0));
     return true;

@@ -361,6 +361,19 @@ namespace lacerta
     state.material = &scene->material;
     state.substeps = substeps;
 
+    // After a topology change or a new level of detail the particles and springs are
+    // others: the integrator's scratch space, the stability limit and the energy
+    // baseline of the blow-up monitor start afresh (the invariants are checked first
+    // if @p check_now).
+    const auto system_changed = [&](const unsigned int step, const bool check_now)
+    {
+      if (check_now)
+        check(step);
+      integrator->initialize(system);
+      substeps = state.substeps = choose_substeps();
+      monitor                   = physics::BlowUpMonitor(system, energy_tolerance);
+      state.mesh                = &scene->active_mesh();
+    };
     const auto evaluate_energies = [&]
     {
       state.kinetic_energy    = system.kinetic_energy();
@@ -425,15 +438,9 @@ namespace lacerta
         stroke_update += cut.update_seconds;
         if (cut.changed)
         {
-          // New particles and springs: the constraints take over the copies of
-          // their particles; the integrator's scratch space, the stability limit and
-          // the energy baseline of the blow-up monitor start afresh.
+          // The constraints take over the copies of their particles.
           scene->follow_cut(cut.copied_particles);
-          check(step);
-          integrator->initialize(system);
-          substeps       = choose_substeps();
-          state.substeps = substeps;
-          monitor        = physics::BlowUpMonitor(system, energy_tolerance);
+          system_changed(step, true);
         }
       }
       if (scene->lacerator)
@@ -465,16 +472,10 @@ namespace lacerta
           if (!test_mode)
             std::cout << "; " << 1e3 * tear.update_seconds << " ms";
           std::cout << "\n";
-          // The scalpel's search structures must see the torn faces; then as after a
-          // cut: constraints follow the copies, new scratch space, stability limit and
-          // energy baseline.
+          // As after a cut; the scalpel's search structures must see the torn faces.
           scene->follow_cut(tear.copied_particles);
           scene->restart_cutter();
-          check(step);
-          integrator->initialize(system);
-          substeps       = choose_substeps();
-          state.substeps = substeps;
-          monitor        = physics::BlowUpMonitor(system, energy_tolerance);
+          system_changed(step, true);
         }
       }
       const auto   relax_start = Clock::now();
@@ -528,21 +529,10 @@ namespace lacerta
                   << " (the cutter's mesh had " << mt_cut->pieces_before << ")\n";
         stroke_cut = stroke_created = 0;
         stroke_update               = 0;
-        check(step);
-        integrator->initialize(system);
-        substeps = state.substeps = choose_substeps();
-        monitor                   = physics::BlowUpMonitor(system, energy_tolerance);
-        state.mesh                = &scene->active_mesh();
+        system_changed(step, true);
       }
       if (scene->update_level_of_detail(time, step, std::cout))
-      {
-        // Other particles and springs: new scratch space, stability limit and energy
-        // reference.
-        integrator->initialize(system);
-        substeps = state.substeps = choose_substeps();
-        monitor                   = physics::BlowUpMonitor(system, energy_tolerance);
-        state.mesh                = &scene->active_mesh();
-      }
+        system_changed(step, false);
       state.step          = step;
       state.time          = time;
       state.time_step     = dt;

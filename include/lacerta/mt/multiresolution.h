@@ -91,6 +91,16 @@ namespace lacerta::mt
     MtCutter::Statistics
     apply_cut(const std::vector<cut::CutRecord> &records, double snap_fraction);
 
+    /**
+     * The level of detail before the last change, once the MT has been cut (after
+     * apply_cut(): the mesh the cutter cut); empty before the first cut.
+     */
+    const mesh::TetMesh &
+    previous_mesh() const
+    {
+      return previous;
+    }
+
     /// The MT vertex id of every vertex of active_mesh(), increasing.
     const std::vector<std::uint32_t> &
     active_vertices() const
@@ -151,9 +161,9 @@ namespace lacerta::mt
     mesh::Point3                               last_focus{};
     unsigned int                               last_step = 0;
     mesh::TetMesh                              mesh;
-    /// The level of detail before the last re-extraction, kept once the MT has been
-    /// cut: transfer_state() then locates new vertices geometrically, side by side.
-    mesh::TetMesh              previous_mesh;
+    /// The level of detail before the last change, kept once the MT has been cut
+    /// (mt_cutter exists): transfer_state() then carries state geometrically.
+    mesh::TetMesh              previous;
     std::vector<std::uint32_t> vertices;
     std::size_t                n_kept = 0, n_new = 0;
   };

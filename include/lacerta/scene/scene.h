@@ -170,6 +170,16 @@ namespace lacerta::scene
     void
     assemble(const mesh::TetMesh &active, double t);
 
+    /**
+     * Moves the particle system to the level of detail the MT now holds, at time @p t:
+     * assembles it there, fills its positions and velocities with
+     * @p transfer(old_x, old_v, x, v) from the state it had, enforces the constraints,
+     * refreshes the force model and restarts the cutter on the new mesh.
+     */
+    template <typename Transfer>
+    void
+    move_to_level_of_detail(double t, const Transfer &transfer);
+
     /// The mesh the cutter cuts: the level of detail's, or the mesh.
     mesh::TetMesh &
     mesh_to_cut();
