@@ -176,17 +176,13 @@ namespace lacerta::mt
                : static_cast<std::size_t>(-1);
     };
     n_kept = n_new = 0;
+    // A cut MT: the walk of locate_in_previous() may end in a tetrahedron across the
+    // opened cut, and each level's cut surface is snapped differently, so new vertices
+    // are interpolated geometrically in the previous level's piece that holds their
+    // tetrahedra. Kept vertices keep their own state below: their MT id is exact, also
+    // on the cut, where copies share a position and only the id tells the sides apart.
     if (mt_cutter)
-    {
-      // A cut MT: the walk of locate_in_previous() may end in a tetrahedron across the
-      // opened cut, whose particles have moved apart; the geometric transfer picks the
-      // tetrahedron on the vertex's own side.
-      const CutTransferReport report =
-        transfer_state_across_cut(previous, old_x, old_v, mesh, x, v);
-      n_kept = report.copied;
-      n_new  = report.interpolated;
-      return;
-    }
+      transfer_state_across_cut(previous, old_x, old_v, mesh, x, v);
     for (std::size_t i = 0; i < vertices.size(); ++i)
     {
       const std::size_t o = old_index(vertices[i]);
@@ -201,6 +197,8 @@ namespace lacerta::mt
         continue;
       }
       ++n_new;
+      if (mt_cutter)
+        continue;
       auto [tet, lambda] = lod->locate_in_previous(vertices[i]);
       double sum         = 0;
       for (double &l : lambda)

@@ -217,7 +217,9 @@ namespace lacerta
       }
     }
     // The MT walk put 241 of 839 off their side; the geometric transfer leaves two
-    // vertices lying on the cut plane (doc/mt-cutting.md, not done yet).
+    // vertices lying on the cut plane: one whose tetrahedra lie mostly in the other
+    // piece of the differently snapped previous level, one interpolated with clamped
+    // coordinates (doc/mt-cutting.md, "Not done yet").
     EXPECT_LE(n_off, 2u);
     std::cout << n_off << " of " << n_checked
               << " particles near the cut off their side's state\n";
