@@ -1,6 +1,7 @@
 // Lacerations (Section 7) on a slab: the threshold h, a tear that stops where the stress
-// is low against the tissue's strength, a complete tear, the invariants after a tear and
-// a later scalpel cut, the dynamics after a tear, and a bad maximum elongation.
+// is low against the tissue's strength or where a pull near one edge fades, a complete
+// tear, the invariants after a tear and a later scalpel cut, the dynamics after a tear,
+// and a bad maximum elongation.
 #include <lacerta/base/exceptions.h>
 #include <lacerta/cut/cutter.h>
 #include <lacerta/cut/invariants.h>
@@ -19,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <iostream>
 #include <memory>
 #include <set>
 
@@ -254,6 +256,31 @@ TEST(CutLaceration, TearStopsWhereTheStressIsLow)
   EXPECT_NEAR(hi, 1.0, 1e-12);
   EXPECT_GT(lo, 0.3);
   EXPECT_LT(lo, 0.7);
+}
+
+
+TEST(CutLaceration, TearStopsWhereAPullNearOneEdgeFades)
+{
+  // Uniform tissue, pulled along x near the edge y = 1 only: the stretch 0.6 y^2 puts
+  // the springs along x past the limit 0.3 for y > 0.71 and past half of it for
+  // y > 0.5 only, so the tear must start at y = 1 and stop inside the slab.
+  const auto pulled_near_one_edge = [](const Point &p)
+  {
+    const double s = 0.6 * p[1] * p[1];
+    return Point{{0.5 + (1 + s) * (p[0] - 0.5), p[1], p[2]}};
+  };
+  TearFixture                     f(pulled_near_one_edge, constant_limit, 3);
+  const cut::LacerationStatistics s = f.lacerator->check();
+  ASSERT_TRUE(s.torn);
+  EXPECT_FALSE(s.complete);
+  f.expect_invariants("after the tear");
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  EXPECT_EQ(cut::count_components(f.mesh), 1u);
+  const auto [lo, hi] = f.torn_y_range();
+  EXPECT_NEAR(hi, 1.0, 1e-12);
+  EXPECT_GT(lo, 0.3);
+  EXPECT_LT(lo, 0.7);
+  std::cout << "tear from y = " << hi << " down to y = " << lo << '\n';
 }
 
 
