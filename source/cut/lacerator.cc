@@ -2,6 +2,7 @@
 #include <lacerta/cut/lacerator.h>
 #include <lacerta/physics/particle_system.h>
 
+#include <deal.II/base/exceptions.h>
 #include <deal.II/base/function.h>
 #include <deal.II/base/point.h>
 
@@ -201,6 +202,47 @@ namespace lacerta::cut
 
 
   void
+  Lacerator::set_recorder(std::vector<CutRecord> *records)
+  {
+    recorder = records;
+    for (Laceration &l : lacerations)
+      if (l.cutter)
+        l.cutter->set_recorder(records);
+  }
+
+
+  void
+  Lacerator::particles_replaced(const std::vector<std::uint8_t> &created_by_cut)
+  {
+    AssertDimension(created_by_cut.size(), system.n_particles());
+    surface_valid = false;
+    for (Laceration &l : lacerations)
+      l.cutter.reset();
+    // The particles the lacerations created, found again by their rest positions: the
+    // MT's version of a torn level (and any later level) puts its own vertices on the
+    // rest tear surface, within about one element of those the lacerations' cutters
+    // created. O(particles created by cuts x particles created by lacerations).
+    sheet.assign(system.n_particles(), no_laceration);
+    for (unsigned int v = 0; v < system.n_particles(); ++v)
+      if (created_by_cut[v])
+      {
+        const Point &x    = mesh.vertex(v);
+        double       best = std::numeric_limits<double>::infinity();
+        for (unsigned int i = 0; i < lacerations.size(); ++i)
+          for (const Point &y : lacerations[i].created_rest)
+          {
+            const double d = norm(sub(x, y));
+            if (d <= lacerations[i].edge && d < best)
+            {
+              best     = d;
+              sheet[v] = i;
+            }
+          }
+      }
+  }
+
+
+  void
   Lacerator::find_crossings(const Laceration &l)
   {
     crossings.clear();
@@ -239,6 +281,8 @@ namespace lacerta::cut
   {
     Laceration &l = lacerations[index];
     if (!l.cutter)
+    {
+      // A new laceration, or a stopped one whose particle system was replaced.
       l.cutter = std::make_shared<Cutter>(mesh,
                                           system,
                                           density,
@@ -246,6 +290,8 @@ namespace lacerta::cut
                                           integral_of_density,
                                           cut_parameters,
                                           blade_at(l, from));
+      l.cutter->set_recorder(recorder);
+    }
     double       u     = from;
     const double exit  = l.end + l.edge;
     const auto   apply = [&](const double next)
@@ -254,7 +300,10 @@ namespace lacerta::cut
       const CutStepStatistics c      = l.cutter->move_blade(blade_at(l, next));
       sheet.resize(system.n_particles(), no_laceration);
       for (unsigned int v = before; v < system.n_particles(); ++v)
+      {
         sheet[v] = index;
+        lacerations[index].created_rest.push_back(mesh.vertex(v));
+      }
       s.cut_tets += c.cut_tets;
       s.created_tets += c.created_tets;
       s.new_particles += c.new_particles;
@@ -427,13 +476,16 @@ namespace lacerta::cut
       const double u       = dot(l.advance, r);
       const bool   created = (seed.a < sheet.size() && sheet[seed.a] == i)
                            || (seed.b < sheet.size() && sheet[seed.b] == i);
-      if (l.cutter
+      if (!l.complete
           && (created
               || (std::abs(dot(l.normal, r)) <= l.edge && u > l.stop - l.edge
                   && u <= l.stop + 2 * l.edge)))
       {
         s.continued = true;
         find_crossings(l);
+        // Without its cutter (the particle system was replaced) a new one starts at
+        // the tip; the cells in which the MT closed the crack stay closed
+        // (doc/lacerations.md, "Limits").
         advance(i, l.stop, l.stop, s);
         s.complete = lacerations[i].complete;
         break;

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
 
 namespace lacerta::scene
@@ -80,11 +81,9 @@ namespace lacerta::scene
     }
     if (cut::Lacerator::enabled(prm))
     {
-      if (multiresolution)
-        throw_error("Laceration/Enabled: lacerations on the multiresolution model are "
-                    "not available yet; set 'Multiresolution/Enabled = false' or "
-                    "'Laceration/Enabled = false'.");
-      lacerator = std::make_unique<cut::Lacerator>(mesh,
+      // On a multiresolution model a tear cuts the level of detail like the scalpel
+      // and its records update the MT after it (doc/lacerations.md).
+      lacerator = std::make_unique<cut::Lacerator>(mesh_to_cut(),
                                                    *system,
                                                    material.density(),
                                                    material.youngs_modulus(),
@@ -92,6 +91,8 @@ namespace lacerta::scene
                                                    integral_of_density,
                                                    cutter_parameters,
                                                    cut::Lacerator::parse_parameters(prm));
+      if (multiresolution)
+        lacerator->set_recorder(&cut_records);
     }
   }
 
@@ -132,14 +133,27 @@ namespace lacerta::scene
     system->enforce_constraints(t, system->position.data(), system->velocity.data());
     system->update_force_model(n_threads);
     restart_cutter();
+    if (lacerator)
+    {
+      // Particles the MT's cuts created (the last cut_origin.size() vertex ids): among
+      // them the lacerator finds those of its tears again.
+      const mt::MultiTriangulation     &mt    = multiresolution->multi_triangulation();
+      const std::size_t                 first = mt.vertices.size() - mt.cut_origin.size();
+      const std::vector<std::uint32_t> &ids   = multiresolution->active_vertices();
+      std::vector<std::uint8_t>         created(ids.size());
+      for (std::size_t i = 0; i < ids.size(); ++i)
+        created[i] = ids[i] >= first;
+      lacerator->particles_replaced(created);
+    }
   }
 
 
   std::optional<Scene::MultiresolutionCut>
   Scene::update_multiresolution_after_cut(const double t)
   {
-    if (!multiresolution || !cutter || cut_records.empty()
-        || !cutter->active_tets().empty())
+    // Tears are complete strokes: only a scalpel's stroke in progress makes it wait.
+    if (!multiresolution || cut_records.empty()
+        || (cutter && !cutter->active_tets().empty()))
       return std::nullopt;
     MultiresolutionCut result;
     result.pieces_before = cut::count_components(multiresolution->active_mesh());

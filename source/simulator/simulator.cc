@@ -460,6 +460,11 @@ namespace lacerta
           n_torn += tear.cut_tets;
           n_tear_created += tear.created_tets;
           sum_tear += tear.update_seconds;
+          // On a multiresolution model the tear's split goes to the MT like a stroke's
+          // (doc/lacerations.md): Table 2's CuT, CrT and TetUp include it.
+          stroke_cut += tear.cut_tets;
+          stroke_created += tear.created_tets;
+          stroke_update += tear.update_seconds;
           std::cout << "Laceration at t = " << time + dt
                     << " s: " << (tear.continued ? "continued" : "started")
                     << " at the spring " << tear.seed_a << "-" << tear.seed_b << " ("
@@ -468,7 +473,8 @@ namespace lacerta
                     << tear.advances << " advances, "
                     << (tear.complete ? "through" : "stopped inside") << "; "
                     << tear.cut_tets << " tetrahedra split into " << tear.created_tets
-                    << "; mesh components " << cut::count_components(scene->mesh);
+                    << "; mesh components "
+                    << cut::count_components(scene->active_mesh());
           if (!test_mode)
             std::cout << "; " << 1e3 * tear.update_seconds << " ms";
           std::cout << "\n";
@@ -601,8 +607,9 @@ namespace lacerta
                 << " tetrahedra split into " << n_tear_created;
       if (!test_mode && n_tears > 0)
         std::cout << ", " << 1e3 * sum_tear / n_tears << " ms per tear";
-      std::cout << "; mesh " << scene->mesh.n_tets() << " tetrahedra, components "
-                << cut::count_components(scene->mesh) << "\n";
+      std::cout << "; mesh " << scene->active_mesh().n_tets()
+                << " tetrahedra, components "
+                << cut::count_components(scene->active_mesh()) << "\n";
     }
     if (!test_mode)
     {

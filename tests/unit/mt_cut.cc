@@ -30,6 +30,8 @@ namespace lacerta
 
     constexpr double density = 1000;
 
+    using test_support::boundary_area;
+    using test_support::expect_front_of_dag;
     using test_support::make_query;
 
     std::unique_ptr<mt::LodQuery>
@@ -87,42 +89,6 @@ namespace lacerta
                                      const cut::CutStepStatistics &) { return true; });
       }
     };
-
-    /// The active set is exactly the live tets whose creator is applied and whose
-    /// destroyer is not, and the applied set is closed under parents: every
-    /// root-to-leaf path of the DAG crosses exactly one arc of the front.
-    void
-    expect_front_of_dag(const mt::MultiTriangulation &mt, const mt::Lod &lod)
-    {
-      for (std::uint32_t t = 0; t < mt.n_tets(); ++t)
-      {
-        const bool expected =
-          mt.is_live(t) && lod.is_applied(mt.creator[t])
-          && (mt.destroyer[t] == mesh::invalid_index || !lod.is_applied(mt.destroyer[t]));
-        ASSERT_EQ(lod.is_active(t), expected) << "tet " << t;
-      }
-      for (std::uint32_t j = 1; j < mt.n_nodes(); ++j)
-        if (lod.is_applied(j))
-          mt.for_each_coarse(j,
-                             [&](const std::uint32_t t)
-                             { ASSERT_TRUE(lod.is_applied(mt.creator[t])) << j; });
-    }
-
-    /// Area of the boundary of @p m.
-    double
-    boundary_area(const mesh::TetMesh &m)
-    {
-      double area = 0;
-      for (const auto &f : m.get_boundary_faces())
-      {
-        const auto &l = mesh::TetMesh::face_vertices[f.face];
-        const Tet  &t = m.tet(f.tet);
-        area += 0.5
-                * cut::norm(cut::cross(cut::sub(m.vertex(t[l[1]]), m.vertex(t[l[0]])),
-                                       cut::sub(m.vertex(t[l[2]]), m.vertex(t[l[0]]))));
-      }
-      return area;
-    }
 
     /**
      * Extracts @p query from scratch and checks it: conforming with positive cells,

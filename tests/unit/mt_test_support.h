@@ -1,9 +1,15 @@
 // Helpers shared by the Multi-Triangulation tests.
 #pragma once
 
+#include <lacerta/cut/geometry.h>
+#include <lacerta/mesh/tet_mesh.h>
+#include <lacerta/mt/lod.h>
 #include <lacerta/mt/lod_query.h>
+#include <lacerta/mt/multi_triangulation.h>
 
 #include <deal.II/base/parameter_handler.h>
+
+#include <gtest/gtest.h>
 
 #include <map>
 #include <memory>
@@ -22,5 +28,41 @@ namespace lacerta::test_support
       prm.set(entry, value);
     prm.leave_subsection();
     return mt::LodQueryRegistry::create_and_parse(name, prm);
+  }
+
+  /// The active set is exactly the live tets whose creator is applied and whose
+  /// destroyer is not, and the applied set is closed under parents: every
+  /// root-to-leaf path of the DAG crosses exactly one arc of the front.
+  inline void
+  expect_front_of_dag(const mt::MultiTriangulation &mt, const mt::Lod &lod)
+  {
+    for (std::uint32_t t = 0; t < mt.n_tets(); ++t)
+    {
+      const bool expected =
+        mt.is_live(t) && lod.is_applied(mt.creator[t])
+        && (mt.destroyer[t] == mesh::invalid_index || !lod.is_applied(mt.destroyer[t]));
+      ASSERT_EQ(lod.is_active(t), expected) << "tet " << t;
+    }
+    for (std::uint32_t j = 1; j < mt.n_nodes(); ++j)
+      if (lod.is_applied(j))
+        mt.for_each_coarse(j,
+                           [&](const std::uint32_t t)
+                           { ASSERT_TRUE(lod.is_applied(mt.creator[t])) << j; });
+  }
+
+  /// Area of the boundary of @p m (rest configuration).
+  inline double
+  boundary_area(const mesh::TetMesh &m)
+  {
+    double area = 0;
+    for (const auto &f : m.get_boundary_faces())
+    {
+      const auto      &l = mesh::TetMesh::face_vertices[f.face];
+      const mesh::Tet &t = m.tet(f.tet);
+      area += 0.5
+              * cut::norm(cut::cross(cut::sub(m.vertex(t[l[1]]), m.vertex(t[l[0]])),
+                                     cut::sub(m.vertex(t[l[2]]), m.vertex(t[l[0]]))));
+    }
+    return area;
   }
 } // namespace lacerta::test_support

@@ -6,6 +6,7 @@
  */
 #pragma once
 
+#include <lacerta/cut/cut_record.h>
 #include <lacerta/cut/cutter.h>
 #include <lacerta/cut/geometry.h>
 #include <lacerta/mesh/tet_mesh.h>
@@ -13,6 +14,7 @@
 #include <deal.II/base/parameter_handler.h>
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -121,6 +123,35 @@ namespace lacerta::cut
     void
     mesh_changed();
 
+    /**
+     * Makes every cutter of a laceration, present and future, append a record of each
+     * sweep to @p records (Cutter::set_recorder()), so that the Multi-Triangulation can
+     * be split along the tears as along cuts (doc/mt-cutting.md); nullptr stops it.
+     */
+    void
+    set_recorder(std::vector<CutRecord> *records);
+
+    /**
+     * Tells the lacerator that the particle system now lives on another mesh (the
+     * object it was built with, refilled: the MT's version of the torn level of detail,
+     * or a re-extraction), so particle numbers changed. The surface springs are
+     * collected again; the cutters of lacerations that stopped inside are dropped (a
+     * continuation builds a new one at the tip, on the new mesh); a particle flagged in
+     * @p created_by_cut (one entry per particle) is again one a laceration created if it
+     * lies, at rest, within one band of a particle that laceration created — the
+     * nearest such laceration (doc/lacerations.md).
+     */
+    void
+    particles_replaced(const std::vector<std::uint8_t> &created_by_cut);
+
+    /// Whether particle @p v is one a laceration created (found again after
+    /// particles_replaced()); such particles' springs do not start tears.
+    bool
+    created_by_laceration(const unsigned int v) const
+    {
+      return v < sheet.size() && sheet[v] != static_cast<unsigned int>(-1);
+    }
+
     /// Number of tears so far (a continued laceration counts each advance phase).
     unsigned int
     n_tears() const
@@ -147,8 +178,11 @@ namespace lacerta::cut
       bool   complete = false;
       /// The section's extent along `across` (the blade spans it).
       double across_lo = 0, across_hi = 0;
-      /// Its cutter while it may still continue (it stopped inside the body).
+      /// Its cutter while it may still continue (it stopped inside the body); dropped
+      /// when the particle system is replaced, then built again at the tip.
       std::shared_ptr<Cutter> cutter;
+      /// Rest positions of the particles it created (to find them again on a new mesh).
+      std::vector<Point> created_rest;
     };
 
     /// A spring crossing a laceration plane: where (along `advance`) and its state.
@@ -216,6 +250,8 @@ namespace lacerta::cut
     /// For every particle, the laceration that created it (or none).
     std::vector<unsigned int> sheet;
     unsigned int              tears = 0;
+    /// Where the lacerations' cutters record their sweeps, or nullptr.
+    std::vector<CutRecord> *recorder = nullptr;
     /// Mean rest length of the surface springs of the mesh as built.
     double typical_edge = 0;
   };

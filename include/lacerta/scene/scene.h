@@ -83,13 +83,13 @@ namespace lacerta::scene
     };
 
     /**
-     * With multiresolution and a tool: once the stroke is over (the blade is in no
-     * tetrahedron) and the cutter has cut the level of detail since the last call,
-     * updates the MT with the cutter's records, rebuilds the particle system on the
-     * MT's version of the cut level of detail at time @p t (state carried over by
-     * mt::transfer_state_across_cut(), masses scaled to ∫σ, constraints applied to
-     * the particles in their regions) and restarts the cutter on it. Returns what it
-     * did, or nothing if there was nothing to do.
+     * With multiresolution: once the scalpel's stroke is over (its blade is in no
+     * tetrahedron, or there is no scalpel) and the scalpel or a tear has cut the level
+     * of detail since the last call, updates the MT with their records, rebuilds the
+     * particle system on the MT's version of the cut level of detail at time @p t (state
+     * carried over by mt::transfer_state_across_cut(), masses scaled to ∫σ, constraints
+     * applied to the particles in their regions) and restarts the cutter on it. Returns
+     * what it did, or nothing if there was nothing to do.
      */
     std::optional<MultiresolutionCut>
     update_multiresolution_after_cut(double t);
@@ -174,7 +174,8 @@ namespace lacerta::scene
      * Moves the particle system to the level of detail the MT now holds, at time @p t:
      * assembles it there, fills its positions and velocities with
      * @p transfer(old_x, old_v, x, v) from the state it had, enforces the constraints,
-     * refreshes the force model and restarts the cutter on the new mesh.
+     * refreshes the force model, restarts the cutter on the new mesh and tells the
+     * lacerator, if any, that the particles changed (Lacerator::particles_replaced()).
      */
     template <typename Transfer>
     void
@@ -184,7 +185,8 @@ namespace lacerta::scene
     mesh::TetMesh &
     mesh_to_cut();
 
-    /// The records of the cutter's sweeps since the last MT update (multiresolution).
+    /// The records of the sweeps of the cutter and the lacerator's cutters since the
+    /// last MT update (multiresolution).
     std::vector<cut::CutRecord> cut_records;
     /// Volume of the level of detail when it was last assembled.
     double level_of_detail_volume = 0;

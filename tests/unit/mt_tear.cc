@@ -1,0 +1,337 @@
+// Lacerations on the multiresolution model (doc/lacerations.md, doc/mt-cutting.md): a
+// tear cuts the level of detail, its records split the MT after it, the scene moves to
+// the MT's version of the torn level, and every later extraction shows the tear.
+#include <lacerta/cut/cutter.h>
+#include <lacerta/cut/geometry.h>
+#include <lacerta/cut/invariants.h>
+#include <lacerta/cut/lacerator.h>
+#include <lacerta/cut/tool.h>
+#include <lacerta/mt/lod.h>
+#include <lacerta/mt/multiresolution.h>
+#include <lacerta/physics/particle_system.h>
+#include <lacerta/scene/scene.h>
+#include <lacerta/simulator/simulator.h>
+
+#include <gtest/gtest.h>
+
+#include "mt_test_support.h"
+#include "physics_test_support.h"
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace lacerta
+{
+  namespace
+  {
+    constexpr double density = 1000, youngs = 1e4;
+    /// The slab [0,1] x [0,1] x [0,0.25].
+    constexpr double volume = 0.25, thickness = 0.25;
+
+    /**
+     * The slab of 8 x 8 x 2 boxes on a multiresolution model whose level of detail is
+     * the MT's finest (`Uniform/Cell size = 0`), tearing past @p limit (an expression
+     * of x, y, z), with the parameter text @p extra appended.
+     */
+    std::unique_ptr<scene::Scene>
+    slab_scene(const std::string &limit, const std::string &extra = "")
+    {
+      const std::string file =
+        (std::filesystem::temp_directory_path() / "lacerta_mt_tear.prm").string();
+      {
+        std::ofstream out(file);
+        out << "subsection Mesh\n  set Source = box\n  subsection Box\n"
+            << "    set Lower corner = 0, 0, 0\n    set Upper corner = 1, 1, 0.25\n"
+            << "    set Repetitions = 8, 8, 2\n  end\nend\n"
+            << "subsection Material\n  set Density = 1000\n  set Youngs modulus = 1e4\n"
+            << "  set Maximum elongation = " << limit << "\nend\n"
+            << "subsection Multiresolution\n  set Enabled = true\n"
+            << "  set Cache directory =\n  set Query = uniform\n"
+            << "  subsection Uniform\n    set Cell size = 0\n  end\nend\n"
+            << "subsection Laceration\n  set Enabled = true\n  set Threshold h = 3\n"
+            << "end\n"
+            << extra;
+      }
+      dealii::ParameterHandler prm;
+      Simulator::read_parameters(file, prm);
+      std::filesystem::remove(file);
+      return std::make_unique<scene::Scene>(prm, 1);
+    }
+
+    /// Puts every particle at its rest position stretched by @p s along x about
+    /// x = @p centre, at rest.
+    void
+    pull(scene::Scene &scene, const double s, const double centre)
+    {
+      const mesh::TetMesh &m = scene.active_mesh();
+      for (unsigned int i = 0; i < m.n_vertices(); ++i)
+      {
+        const mesh::Point3 &r             = m.vertex(i);
+        scene.system->position[3 * i]     = centre + (1 + s) * (r[0] - centre);
+        scene.system->position[3 * i + 1] = r[1];
+        scene.system->position[3 * i + 2] = r[2];
+        scene.system->velocity[3 * i]     = 0;
+        scene.system->velocity[3 * i + 1] = 0;
+        scene.system->velocity[3 * i + 2] = 0;
+      }
+    }
+
+    /// One laceration check of the scene, followed up as the simulator does.
+    cut::LacerationStatistics
+    check_for_tears(scene::Scene &scene)
+    {
+      const cut::LacerationStatistics s = scene.lacerator->check();
+      if (s.changed)
+      {
+        scene.follow_cut(s.copied_particles);
+        scene.restart_cutter();
+      }
+      return s;
+    }
+
+    /// The scene's particle system on its active mesh keeps every invariant.
+    void
+    expect_scene_invariants(const scene::Scene &scene, const std::string &where)
+    {
+      EXPECT_EQ(cut::check_invariants(scene.active_mesh(),
+                                      *scene.system,
+                                      scene.expected_volume(),
+                                      scene.integral_of_density),
+                "")
+        << where;
+    }
+
+    /// Area of the faces a cut or tear opened in @p m (both sides), at rest.
+    double
+    opened_area(const mesh::TetMesh &m)
+    {
+      double area = 0;
+      for (const auto &f : m.get_boundary_faces())
+        if (f.boundary_id == cut::cut_boundary_id)
+        {
+          const auto      &l = mesh::TetMesh::face_vertices[f.face];
+          const mesh::Tet &t = m.tet(f.tet);
+          area += 0.5
+                  * cut::norm(cut::cross(cut::sub(m.vertex(t[l[1]]), m.vertex(t[l[0]])),
+                                         cut::sub(m.vertex(t[l[2]]), m.vertex(t[l[0]]))));
+        }
+      return area;
+    }
+
+    /// Lowest rest y of the faces a cut or tear opened in @p m.
+    double
+    opened_lowest_y(const mesh::TetMesh &m)
+    {
+      double lo = 1e300;
+      for (const auto &f : m.get_boundary_faces())
+        if (f.boundary_id == cut::cut_boundary_id)
+          for (const unsigned int k : mesh::TetMesh::face_vertices[f.face])
+            lo = std::min(lo, m.vertex(m.tet(f.tet)[k])[1]);
+      return lo;
+    }
+
+    /**
+     * Extracts the MT at cell size @p h from scratch and checks it: a front of the
+     * DAG, conforming with positive cells, the slab's volume, masses summing to ∫σ,
+     * and @p components pieces. Returns the mesh.
+     */
+    mesh::TetMesh
+    extract(const mt::MultiTriangulation &mt,
+            const double                  h,
+            const unsigned int            components,
+            const std::string            &where)
+    {
+      mt::Lod lod(mt);
+      lod.extract(
+        *test_support::make_query("uniform", {{"Cell size", std::to_string(h)}}));
+      test_support::expect_front_of_dag(mt, lod);
+      mesh::TetMesh m      = lod.make_mesh(lod.active_vertices(), "extraction");
+      const auto    system = test_support::make_system(m, density, youngs);
+      EXPECT_EQ(cut::check_invariants(m, *system, volume, density * volume), "")
+        << where << ", cell size " << h;
+      EXPECT_EQ(cut::count_components(m), components) << where << ", cell size " << h;
+      return m;
+    }
+
+    /// Weak in the column of cells 0.375 < x < 0.5 near the edge y = 1 only: under a
+    /// stretch of 0.4 its springs along x pass their limit for y > 0.78 and half of it
+    /// for y > 0.5 (tests/unit/cut_laceration.cc).
+    const std::string weak_column = "abs(x - 0.4375) < 0.07 ? 0.3 + 2*(1 - y)^2 : 10";
+    const std::string weak_near_one_edge = "0.3 + 2*(1 - y)^2";
+  } // namespace
+
+
+  TEST(MtTear, TwoPullsTearTheMtAndEveryLevelShowsIt)
+  {
+    auto                          scene = slab_scene(weak_column);
+    const mt::MultiTriangulation &mt    = scene->multiresolution->multi_triangulation();
+    ASSERT_EQ(scene->active_mesh().n_tets(), 640u);
+    const double slab_area = test_support::boundary_area(scene->active_mesh());
+    // Every extraction before the tear (the middle and coarsest levels' areas).
+    const double middle_area0 =
+      test_support::boundary_area(extract(mt, 0.3, 1, "before the tear"));
+    const mesh::TetMesh coarsest0 = extract(mt, 1000, 1, "before the tear");
+    ASSERT_LT(coarsest0.n_tets(), 20u);
+
+    // First pull: the tear starts at the weak edge y = 1 and stops inside.
+    pull(*scene, 0.4, 0.4375);
+    const cut::LacerationStatistics first = check_for_tears(*scene);
+    ASSERT_TRUE(first.torn);
+    ASSERT_FALSE(first.complete);
+    ASSERT_TRUE(scene->cut_pending());
+    expect_scene_invariants(*scene, "after the first tear, on the level of detail");
+    // The tear's area at rest, from the faces it opened (both sides), against the
+    // section it crossed: from y = 1 down to where it stopped, through the thickness.
+    const double torn = 0.5 * opened_area(scene->active_mesh());
+    const double stop = opened_lowest_y(scene->active_mesh());
+    EXPECT_GT(stop, 0.3);
+    EXPECT_LT(stop, 0.7);
+    EXPECT_NEAR(torn, thickness * (1 - stop), 0.15 * thickness * (1 - stop));
+
+    // The MT is split after the tear and the scene moves to its version of the torn
+    // level of detail.
+    const auto update = scene->update_multiresolution_after_cut(0.5);
+    ASSERT_TRUE(update.has_value());
+    EXPECT_FALSE(scene->cut_pending());
+    EXPECT_GT(update->update.split_fragments, 0u);
+    EXPECT_GT(update->update.new_vertices, 0u);
+    EXPECT_EQ(update->pieces_after, 1u);
+    EXPECT_NO_THROW(mt.check("torn MT"));
+    expect_scene_invariants(*scene, "on the MT's version of the torn level");
+    // The finest extraction shows both sides of the tear, up to the cell row at its
+    // tip in which the MT closes the crack (one element, 1/8, through the thickness).
+    const double        tip_row = 2 * thickness / 8;
+    const mesh::TetMesh finest  = extract(mt, 0, 1, "after the first pull");
+    const double        opened  = test_support::boundary_area(finest) - slab_area;
+    EXPECT_LE(opened, 2 * torn + 1e-9);
+    EXPECT_GE(opened, 2 * torn - tip_row);
+    EXPECT_NEAR(test_support::boundary_area(scene->active_mesh()) - slab_area,
+                opened,
+                1e-12);
+    // A middle level shows it too; the coarsest (a handful of cells spanning the slab,
+    // each containing the tip) closes all of it, but stays valid.
+    const double middle_opened =
+      test_support::boundary_area(extract(mt, 0.3, 1, "after the first pull"))
+      - middle_area0;
+    EXPECT_GT(middle_opened, 0.5 * opened);
+    EXPECT_LT(middle_opened, 2 * opened);
+    extract(mt, 1000, 1, "after the first pull");
+    ASSERT_FALSE(::testing::Test::HasFailure());
+
+    // The lacerator found its tear's particles on the new mesh: particles the MT's
+    // split created on the tear's surface (rest x near the plane x = 0.4375, above
+    // where it stopped), and no others.
+    unsigned int n_found = 0;
+    for (unsigned int v = 0; v < scene->system->n_particles(); ++v)
+      if (scene->lacerator->created_by_laceration(v))
+      {
+        ++n_found;
+        const mesh::Point3 &r = scene->active_mesh().vertex(v);
+        EXPECT_NEAR(r[0], 0.4375, 0.07) << "particle " << v;
+        EXPECT_GT(r[1], stop - 0.2) << "particle " << v;
+      }
+    EXPECT_GT(n_found, 20u);
+    // At the same stretch nothing tears again (the torn surface's springs do not seed
+    // a second tear).
+    pull(*scene, 0.4, 0.4375);
+    EXPECT_FALSE(check_for_tears(*scene).torn);
+
+    // Second pull, about the tear's plane: the same laceration goes on from its tip,
+    // with a cutter built there on the MT's mesh, down to the far rim.
+    pull(*scene, 1.5, 0.4375);
+    const cut::LacerationStatistics second = check_for_tears(*scene);
+    ASSERT_TRUE(second.torn);
+    EXPECT_TRUE(second.continued);
+    EXPECT_TRUE(second.complete);
+    EXPECT_GT(second.cut_tets, 0u);
+    EXPECT_EQ(scene->lacerator->n_tears(), 2u);
+    expect_scene_invariants(*scene, "after the second tear, on the level of detail");
+    const auto again = scene->update_multiresolution_after_cut(1.0);
+    ASSERT_TRUE(again.has_value());
+    EXPECT_NO_THROW(mt.check("torn MT, continued"));
+    expect_scene_invariants(*scene, "on the MT's version of the continued tear");
+    // The whole section is open at the finest level (1 x 0.25, both sides) but for the
+    // cells at the first tear's tip, which the MT closed and the continuation, started
+    // at the tip, does not open again (doc/lacerations.md, "Limits"): a bridge of one
+    // cell row keeps the slab in one piece at every level.
+    const mesh::TetMesh through = extract(mt, 0, 1, "after the second pull");
+    EXPECT_GT(test_support::boundary_area(through) - slab_area,
+              2 * thickness - 1.5 * tip_row);
+    extract(mt, 0.3, 1, "after the second pull");
+    extract(mt, 1000, 1, "after the second pull");
+  }
+
+
+  TEST(MtTear, UniformStretchTearsEveryLevelThrough)
+  {
+    auto                          scene = slab_scene("0.3");
+    const mt::MultiTriangulation &mt    = scene->multiresolution->multi_triangulation();
+    const double slab_area = test_support::boundary_area(scene->active_mesh());
+    pull(*scene, 0.4, 0.5);
+    const cut::LacerationStatistics tear = check_for_tears(*scene);
+    ASSERT_TRUE(tear.torn);
+    ASSERT_TRUE(tear.complete);
+    EXPECT_EQ(cut::count_components(scene->active_mesh()), 2u);
+    const double torn = 0.5 * opened_area(scene->active_mesh());
+    EXPECT_NEAR(torn, thickness, 0.05 * thickness);
+    const auto update = scene->update_multiresolution_after_cut(0.5);
+    ASSERT_TRUE(update.has_value());
+    EXPECT_EQ(update->pieces_before, 2u);
+    EXPECT_EQ(update->pieces_after, 2u);
+    EXPECT_NO_THROW(mt.check("torn MT"));
+    expect_scene_invariants(*scene, "on the MT's version of the torn level");
+    // Two pieces at every level; the finest has both sides of the whole section.
+    const mesh::TetMesh finest = extract(mt, 0, 2, "torn through");
+    EXPECT_NEAR(test_support::boundary_area(finest) - slab_area, 2 * torn, 0.05 * torn);
+    for (const double h : {0.2, 0.3, 0.5, 1000.0})
+      extract(mt, h, 2, "torn through");
+  }
+
+
+  TEST(MtTear, LaceratedThenCutKeepsEveryInvariant)
+  {
+    // A scalpel across the slab along y = 0.2, through the thickness, after the tear:
+    // from x = -0.5 to 2 over a second (the slab spans -0.2 .. 1.2 stretched).
+    auto scene =
+      slab_scene(weak_near_one_edge,
+                 "subsection Tool\n  set Type = scalpel\n  subsection Scalpel\n"
+                 "    set Keyframes = 0, -0.5, 0.2, 0.5, -0.5, 0.2, -0.25; "
+                 "1, 2, 0.2, 0.5, 2, 0.2, -0.25\n  end\nend\n");
+    const mt::MultiTriangulation &mt = scene->multiresolution->multi_triangulation();
+    pull(*scene, 0.4, 0.5);
+    const cut::LacerationStatistics tear = check_for_tears(*scene);
+    ASSERT_TRUE(tear.torn);
+    ASSERT_FALSE(tear.complete);
+    ASSERT_TRUE(scene->update_multiresolution_after_cut(0).has_value());
+    EXPECT_NO_THROW(mt.check("torn MT"));
+    expect_scene_invariants(*scene, "after the tear");
+    ASSERT_FALSE(::testing::Test::HasFailure());
+
+    const unsigned int n_steps = 30;
+    for (unsigned int k = 1; k <= n_steps; ++k)
+    {
+      const cut::CutStepStatistics c =
+        scene->cutter->move_blade(scene->tool->blade(double(k) / n_steps));
+      if (c.changed)
+      {
+        scene->follow_cut(c.copied_particles);
+        scene->lacerator->mesh_changed();
+      }
+      expect_scene_invariants(*scene, "scalpel step " + std::to_string(k));
+      ASSERT_FALSE(::testing::Test::HasFailure());
+    }
+    ASSERT_TRUE(scene->cutter->active_tets().empty());
+    // The scalpel separated the strip y < 0.2 (at rest); the tear did not reach it.
+    EXPECT_EQ(cut::count_components(scene->active_mesh()), 2u);
+    const auto update = scene->update_multiresolution_after_cut(1);
+    ASSERT_TRUE(update.has_value());
+    EXPECT_EQ(update->pieces_after, 2u);
+    EXPECT_NO_THROW(mt.check("torn and cut MT"));
+    expect_scene_invariants(*scene, "after the MT update");
+    for (const double h : {0.0, 0.3, 1000.0})
+      extract(mt, h, 2, "torn and cut");
+    // The lacerator sees the new mesh and stays consistent.
+    check_for_tears(*scene);
+    expect_scene_invariants(*scene, "after a second check");
+  }
+} // namespace lacerta
