@@ -182,7 +182,7 @@ namespace lacerta::mt
     // tetrahedra. Kept vertices keep their own state below: their MT id is exact, also
     // on the cut, where copies share a position and only the id tells the sides apart.
     if (mt_cutter)
-      transfer_state_across_cut(previous, old_x, old_v, mesh, x, v);
+      n_new = transfer_state_across_cut(previous, old_x, old_v, mesh, x, v).interpolated;
     for (std::size_t i = 0; i < vertices.size(); ++i)
     {
       const std::size_t o = old_index(vertices[i]);
@@ -196,9 +196,9 @@ namespace lacerta::mt
         }
         continue;
       }
-      ++n_new;
       if (mt_cutter)
-        continue;
+        continue; // a copy of a particle at its position, or counted as interpolated
+      ++n_new;
       auto [tet, lambda] = lod->locate_in_previous(vertices[i]);
       double sum         = 0;
       for (double &l : lambda)
