@@ -88,7 +88,7 @@ namespace lacerta::bench
       const auto   start = Clock::now();
       mt::MtCutter mt_cutter(mt);
       const double index  = std::chrono::duration<double>(Clock::now() - start).count();
-      const auto   update = mt_cutter.apply(records, &lod);
+      const auto   update = mt_cutter.apply(records, &lod, &mesh);
 
       std::printf("%8u %8u %6u %6u %6u %9.1f %7u %7u %11.1f %8.1f   %5u %7.0f %9.0f\n",
                   input.n_tets(),

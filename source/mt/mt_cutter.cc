@@ -1,4 +1,5 @@
 #include <lacerta/base/exceptions.h>
+#include <lacerta/cut/cutter.h>
 #include <lacerta/mt/mt_cutter.h>
 
 #include <algorithm>
@@ -65,13 +66,16 @@ namespace lacerta::mt
   } // namespace
 
 
-  MtCutter::MtCutter(MultiTriangulation &mt_in, const double snap_fraction_in)
+  MtCutter::MtCutter(MultiTriangulation &mt_in,
+                     const double        snap_fraction_in,
+                     const double        boundary_error)
       : mt(mt_in)
       , snap_fraction(snap_fraction_in)
   {
     cut::Box all;
     for (const auto &p : mt.vertices)
       all.extend(p);
+    rim_extension = 2 * boundary_error * cut::norm(cut::sub(all.upper, all.lower));
     // About eight tetrahedra per cell: a query near the cut touches few cells.
     const double target = std::max(1.0, mt.n_tets() / 8.0);
     double       volume = 1;
@@ -164,7 +168,9 @@ namespace lacerta::mt
 
 
   MtCutter::Statistics
-  MtCutter::apply(const std::vector<cut::CutRecord> &records, Lod *lod)
+  MtCutter::apply(const std::vector<cut::CutRecord> &records,
+                  Lod                               *lod,
+                  const mesh::TetMesh               *cut_mesh)
   {
     const auto start = std::chrono::steady_clock::now();
     Statistics statistics;
@@ -183,6 +189,40 @@ namespace lacerta::mt
     std::vector<Point>                      normal;
     std::vector<std::vector<std::uint32_t>> surface_cells(cells.size());
     std::vector<cut::Box>                   regions;
+    const auto add_triangle = [&](const std::array<Point, 3> &tri, const Point &n)
+    {
+      cut::Box box;
+      for (const auto &p : tri)
+        box.extend(p);
+      for_each_cell(box,
+                    [&](const std::size_t k) {
+                      surface_cells[k].push_back(
+                        static_cast<std::uint32_t>(surface.size()));
+                    });
+      surface.push_back(tri);
+      normal.push_back(n);
+    };
+    // The edges of the cut mesh's boundary faces that are not on the cut (its outer
+    // boundary), by the rest positions of their ends; edges of cut faces among them
+    // are the surface's rim.
+    const auto undirected = [](const Point &a, const Point &b)
+    { return a < b ? std::make_pair(a, b) : std::make_pair(b, a); };
+    std::set<std::pair<Point, Point>> outer_edges;
+    if (cut_mesh && rim_extension > 0)
+      for (const auto &f : cut_mesh->get_boundary_faces())
+        if (f.boundary_id != cut::cut_boundary_id)
+        {
+          const auto &l = mesh::TetMesh::face_vertices[f.face];
+          const auto &t = cut_mesh->tet(f.tet);
+          for (unsigned int k = 0; k < 3; ++k)
+            outer_edges.insert(
+              undirected(cut_mesh->vertex(t[l[k]]), cut_mesh->vertex(t[l[(k + 1) % 3]])));
+        }
+    struct RimEdge
+    {
+      Point a, b, inner, normal;
+    };
+    std::vector<RimEdge> rim;
     for (const auto &record : records)
     {
       cut::Box region;
@@ -208,21 +248,42 @@ namespace lacerta::mt
                     * child.side
                   < 0)
                 n = cut::scale(-1, n);
-              cut::Box box;
-              for (const auto &p : tri)
-                box.extend(p);
-              for_each_cell(box,
-                            [&](const std::size_t k) {
-                              surface_cells[k].push_back(
-                                static_cast<std::uint32_t>(surface.size()));
-                            });
-              surface.push_back(tri);
-              normal.push_back(n);
+              add_triangle(tri, n);
+              if (child.side > 0 && !outer_edges.empty())
+                for (unsigned int k = 0; k < 3; ++k)
+                  if (outer_edges.count(undirected(tri[k], tri[(k + 1) % 3])))
+                    rim.push_back({tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3], n});
             }
         }
       }
       if (!record.cuts.empty())
         regions.push_back(region);
+    }
+    // The surface ends on the boundary of the level of detail that was cut; the other
+    // levels' boundaries lie up to twice the decimation's Hausdorff bound outside it
+    // (each within the bound of the input's), and a tetrahedron sticking out there
+    // would meet the surface's rim inside it: the crack would close there and keep a
+    // bridge along the rim (seen on the kidney, at levels coarse near the cut). Each
+    // rim edge is therefore extended outwards, in its cut face's plane, by
+    // rim_extension. Crack fronts and bridges the cutter left inside are not extended.
+    for (const RimEdge &e : rim)
+    {
+      const Point &a = e.a, &b = e.b, &c = e.inner, &n = e.normal;
+      Point        u      = cut::cross(n, cut::sub(b, a));
+      const double length = cut::norm(u);
+      if (!(length > 0))
+        continue;
+      u = cut::scale(rim_extension / length, u);
+      if (cut::dot(u, cut::sub(c, a)) > 0)
+        u = cut::scale(-1, u);
+      const Point a_out = cut::add(a, u), b_out = cut::add(b, u);
+      cut::Box    flap;
+      for (const Point &p : {a, b, a_out, b_out})
+        flap.extend(p);
+      for (const std::array<Point, 3> &tri :
+           {std::array<Point, 3>{{a, b, b_out}}, std::array<Point, 3>{{a, b_out, a_out}}})
+        add_triangle(tri, n);
+      regions.push_back(flap);
     }
     if (surface.empty())
       return statistics;

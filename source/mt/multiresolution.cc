@@ -99,6 +99,7 @@ namespace lacerta::mt
     parameters.boundary_error_weight  = prm.get_double("Boundary error weight");
     prm.leave_subsection();
     prm.leave_subsection();
+    boundary_error = parameters.maximum_boundary_error;
 
     mt         = load_or_build(input, parameters, locked, directory, cache);
     lod        = std::make_unique<Lod>(mt);
@@ -144,8 +145,8 @@ namespace lacerta::mt
                              const double                       snap_fraction)
   {
     if (!mt_cutter)
-      mt_cutter = std::make_unique<MtCutter>(mt, snap_fraction);
-    const MtCutter::Statistics statistics = mt_cutter->apply(records, lod.get());
+      mt_cutter = std::make_unique<MtCutter>(mt, snap_fraction, boundary_error);
+    const MtCutter::Statistics statistics = mt_cutter->apply(records, lod.get(), &mesh);
     make_active_mesh();
     return statistics;
   }

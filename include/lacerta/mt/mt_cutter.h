@@ -58,19 +58,28 @@ namespace lacerta::mt
 
     /**
      * Prepares cutting @p mt (indexes its tetrahedra at rest), splitting with snapping
-     * fraction @p snap_fraction (the cutter's).
+     * fraction @p snap_fraction (the cutter's). @p boundary_error is the largest
+     * distance between the boundaries of two levels, as a fraction of the bounding box
+     * diagonal (the builder's `maximum_boundary_error`): the cut surface is extended
+     * by twice that beyond the boundary of the level of detail that was cut, so that it
+     * also crosses the levels whose boundary lies outside it.
      */
     explicit MtCutter(MultiTriangulation &mt,
-                      double              snap_fraction = cut::default_snap_fraction);
+                      double              snap_fraction  = cut::default_snap_fraction,
+                      double              boundary_error = 0.01);
 
     /**
      * Splits the MT along the rest cut surface of @p records (made by a Cutter on a
      * level of detail of this MT, in order). If @p lod is given, its active tetrahedra
      * follow their splits (Lod::follow_cut()): it is then this MT's version of the cut
-     * level of detail.
+     * level of detail. If @p cut_mesh (the mesh the records were made on, after them)
+     * is given, the surface is extended past its boundary, so that it also crosses the
+     * levels whose boundary lies outside (the constructor's `boundary_error`).
      */
     Statistics
-    apply(const std::vector<cut::CutRecord> &records, Lod *lod = nullptr);
+    apply(const std::vector<cut::CutRecord> &records,
+          Lod                               *lod      = nullptr,
+          const mesh::TetMesh               *cut_mesh = nullptr);
 
   private:
     /// Calls @p f(k) for the index k of every grid cell @p box meets.
@@ -115,6 +124,8 @@ namespace lacerta::mt
 
     MultiTriangulation &mt;
     double              snap_fraction;
+    /// How far the cut surface is extended beyond the cut level's boundary (m).
+    double rim_extension = 0;
     /// The grid over the tets' boxes at rest: origin, cell size, cells per axis.
     cut::Point                              origin{};
     double                                  cell = 1;

@@ -158,9 +158,11 @@ namespace lacerta::mt
     std::unique_ptr<dealii::FunctionParser<3>> path;
     double                                     distance = 0;
     unsigned int                               interval = 1;
-    mesh::Point3                               last_focus{};
-    unsigned int                               last_step = 0;
-    mesh::TetMesh                              mesh;
+    /// The builder's `Maximum boundary error`, which the MT's cuts must reach past.
+    double        boundary_error = 0.01;
+    mesh::Point3  last_focus{};
+    unsigned int  last_step = 0;
+    mesh::TetMesh mesh;
     /// The level of detail before the last change, kept once the MT has been cut
     /// (mt_cutter exists): transfer_state() then carries state geometrically.
     mesh::TetMesh              previous;
