@@ -207,17 +207,31 @@ namespace lacerta::mt
     // are the surface's rim.
     const auto undirected = [](const Point &a, const Point &b)
     { return a < b ? std::make_pair(a, b) : std::make_pair(b, a); };
+    // Only faces that meet the box of the records' cut tetrahedra can share an edge
+    // with the surface: the set grows with the cut, not with the boundary.
     std::set<std::pair<Point, Point>> outer_edges;
     if (cut_mesh && rim_extension > 0)
+    {
+      cut::Box cut_box;
+      for (const auto &record : records)
+        for (const auto &c : record.cuts)
+          for (const auto &p : c.points)
+            cut_box.extend(p);
       for (const auto &f : cut_mesh->get_boundary_faces())
         if (f.boundary_id != cut::cut_boundary_id)
         {
           const auto &l = mesh::TetMesh::face_vertices[f.face];
           const auto &t = cut_mesh->tet(f.tet);
+          cut::Box    face_box;
+          for (const unsigned int k : l)
+            face_box.extend(cut_mesh->vertex(t[k]));
+          if (!face_box.overlaps(cut_box))
+            continue;
           for (unsigned int k = 0; k < 3; ++k)
             outer_edges.insert(
               undirected(cut_mesh->vertex(t[l[k]]), cut_mesh->vertex(t[l[(k + 1) % 3]])));
         }
+    }
     struct RimEdge
     {
       Point a, b, inner, normal;
