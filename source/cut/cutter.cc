@@ -539,6 +539,7 @@ namespace lacerta::cut
     partial_child.resize(mesh.n_tets(), 0);
     on_surface.resize(mesh.n_vertices(), 0);
     swept.resize(mesh.n_vertices(), 0);
+    crossing_pending.resize(mesh.n_vertices(), 0);
   }
 
 
@@ -683,6 +684,11 @@ namespace lacerta::cut
       {
         VertexScratch &s = vertex_scratch[v];
         s.side           = s.on_plane && s.reached ? 0 : (s.d >= 0 ? 1 : -1);
+        // A vertex of the crack that this stroke's plane reaches only now (where the
+        // path crosses its own crack): its star must be re-split, so that the faces
+        // in the plane through it open.
+        if (s.on_plane && on_surface[v] && !s.reached)
+          crossing_pending[v] = stroke;
       }
       for (const unsigned int v : group_extra)
       {
@@ -734,14 +740,16 @@ namespace lacerta::cut
               missing.push_back(n);
         }
       // A vertex joining the crack needs its whole star (its copies are decided on
-      // it): a vertex newly on the surface, or one of a cell that is cut now. Old
+      // it): a vertex newly on the surface, one of a cell that is cut now, or one of
+      // the crack that the plane reaches only now (see crossing_pending). Old
       // crack vertices elsewhere stay as they are, so the set does not spread along
       // the whole crack.
       for (const unsigned int t : affected)
       {
         const bool is_cut = tet_is_cut(t);
         for (const unsigned int v : mesh.tet(t))
-          if (vertex_scratch[v].side == 0 && (is_cut || !on_surface[v]))
+          if (vertex_scratch[v].side == 0
+              && (is_cut || !on_surface[v] || crossing_pending[v] == stroke))
             vertex_scratch[v].star_stamp = star_stamp;
       }
       for (const unsigned int v : group_extra)
@@ -1123,6 +1131,9 @@ namespace lacerta::cut
       partial_child[t] = child_partial[k] ? stroke : 0;
     }
     child_partial.clear();
+    for (const unsigned int v : verts)
+      if (vertex_scratch[v].star_stamp == star_stamp && v < crossing_pending.size())
+        crossing_pending[v] = 0;
     for (const auto &[pair, f] : stiffness_delta)
     {
       const unsigned int e = mesh.find_edge(pair[0], pair[1]);

@@ -300,6 +300,9 @@ namespace lacerta::cut
     /// Stroke in which a vertex on the plane was swept by the blade (its patch opens
     /// when all of it is swept).
     std::vector<unsigned int> swept;
+    /// Stroke in which a vertex of the crack lay on the plane ahead of the front (a
+    /// later sweep that reaches it re-splits its star).
+    std::vector<unsigned int> crossing_pending;
     /// Stroke in which a tetrahedron was made by a partial split (not split partially
     /// again while the front is inside it).
     std::vector<unsigned int> partial_child;
