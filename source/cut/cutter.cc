@@ -23,6 +23,10 @@ namespace lacerta::cut
     /// that the crack does not start inside a cell (the table has one front only).
     constexpr double start_tolerance = 1e-9;
 
+    /// A blade motion that turns by more than this (radians, about 17 degrees) away
+    /// from the direction since the crack front makes a corner of the path.
+    constexpr double corner_angle = 0.3;
+
     /// Whether local node @p n of a child lies on local face @p f of its parent.
     bool
     node_on_parent_face(const NodeRef &n, const unsigned int f)
@@ -89,6 +93,7 @@ namespace lacerta::cut
       , parameters(parameters_in)
       , current(initial)
       , front(initial)
+      , last_end(initial)
   {
     mesh.enable_local_updates();
     std::vector<double> lengths;
@@ -124,6 +129,7 @@ namespace lacerta::cut
     // Cells made by partial splits and vertices swept belong to this stroke only.
     ++stroke;
     stroke_has_cut = false;
+    after_corner   = false;
   }
 
 
@@ -299,6 +305,33 @@ namespace lacerta::cut
   void
   Cutter::sweep(const Blade &end, CutStepStatistics &statistics)
   {
+    // A corner: the front lags behind the blade (it waits in a cell made by a partial
+    // split, see below) and the blade turns away from the direction since the front.
+    // A sweep from the waiting front to the blade would cut a chord across the corner
+    // (and, crossing the crack's cells diagonally, often nothing at all, leaving the
+    // corner uncut): the front is first brought to the corner, without waiting, so
+    // that the next side starts from the corner line.
+    const auto  mid = [](const Blade &b) { return scale(0.5, add(b.tail, b.head)); };
+    const Point a = sub(mid(last_end), mid(front)), b = sub(mid(end), mid(last_end));
+    if (norm(a) > 1e-12 * typical_edge && norm(b) > 0
+        && dot(a, b) < std::cos(corner_angle) * norm(a) * norm(b))
+    {
+      catching_up = true;
+      sweep_once(last_end, statistics);
+      catching_up  = false;
+      after_corner = after_corner || front.tail == last_end.tail;
+    }
+    sweep_once(end, statistics);
+    // The first sweep of the new side that advances the front ends the corner.
+    if (front.tail == end.tail)
+      after_corner = false;
+    last_end = end;
+  }
+
+
+  void
+  Cutter::sweep_once(const Blade &end, CutStepStatistics &statistics)
+  {
     ++statistics.sweeps;
     const Blade                              &s               = front;
     const std::array<std::array<Point, 3>, 2> swept_triangles = {
@@ -417,9 +450,10 @@ namespace lacerta::cut
       // being re-split at every sweep); a child flat at rest (a vertex kept on the
       // surface lies within ε of the plane, not on it); a partial split that would
       // make a sliver next to a vertex ahead of the front.
-      // (When the blade has left the tissue the front must catch up where it is: no
-      // deferral and no waiting for a better front.)
-      const bool must_follow = active.empty();
+      // (When the blade has left the tissue, or turned at a corner of its path, the
+      // front must catch up where it is: no deferral and no waiting for a better
+      // front.)
+      const bool must_follow = active.empty() || catching_up;
       bool       postpone    = kind == CutKind::unsupported
                       || (kind == CutKind::partial && partial_child[removed[k]] == stroke
                           && !must_follow)
@@ -474,7 +508,13 @@ namespace lacerta::cut
   bool
   Cutter::has_flat_child(const TetCut &cut, const SplitResult &result) const
   {
-    double longest_parent = 0;
+    // A child below 1e-6 of the parent's longest edge cubed is flat. At a corner of
+    // the path the crack bends inside a cell, and a front point clamped off the
+    // corner line (the line may run through a mesh face) leaves thin cells there:
+    // they are accepted down to 1e-8, still a hundred times above what
+    // check_invariants() calls flat, rather than postponing the new side forever.
+    const double flat_volume    = catching_up || after_corner ? 1e-8 : 1e-6;
+    double       longest_parent = 0;
     for (const auto &e : tet_edge_vertices)
       longest_parent =
         std::max(longest_parent, norm(sub(cut.points[e[1]], cut.points[e[0]])));
@@ -482,7 +522,7 @@ namespace lacerta::cut
     {
       const auto p = child_node_points(cut, result, result.children[i]);
       if (!(volume(p[0], p[1], p[2], p[3])
-            > 1e-6 * longest_parent * longest_parent * longest_parent))
+            > flat_volume * longest_parent * longest_parent * longest_parent))
         return true;
     }
     return false;
@@ -499,6 +539,7 @@ namespace lacerta::cut
     partial_child.resize(mesh.n_tets(), 0);
     on_surface.resize(mesh.n_vertices(), 0);
     swept.resize(mesh.n_vertices(), 0);
+    crossing_pending.resize(mesh.n_vertices(), 0);
   }
 
 
@@ -643,6 +684,11 @@ namespace lacerta::cut
       {
         VertexScratch &s = vertex_scratch[v];
         s.side           = s.on_plane && s.reached ? 0 : (s.d >= 0 ? 1 : -1);
+        // A vertex of the crack that this stroke's plane reaches only now (where the
+        // path crosses its own crack): its star must be re-split, so that the faces
+        // in the plane through it open.
+        if (s.on_plane && on_surface[v] && !s.reached)
+          crossing_pending[v] = stroke;
       }
       for (const unsigned int v : group_extra)
       {
@@ -694,14 +740,16 @@ namespace lacerta::cut
               missing.push_back(n);
         }
       // A vertex joining the crack needs its whole star (its copies are decided on
-      // it): a vertex newly on the surface, or one of a cell that is cut now. Old
+      // it): a vertex newly on the surface, one of a cell that is cut now, or one of
+      // the crack that the plane reaches only now (see crossing_pending). Old
       // crack vertices elsewhere stay as they are, so the set does not spread along
       // the whole crack.
       for (const unsigned int t : affected)
       {
         const bool is_cut = tet_is_cut(t);
         for (const unsigned int v : mesh.tet(t))
-          if (vertex_scratch[v].side == 0 && (is_cut || !on_surface[v]))
+          if (vertex_scratch[v].side == 0
+              && (is_cut || !on_surface[v] || crossing_pending[v] == stroke))
             vertex_scratch[v].star_stamp = star_stamp;
       }
       for (const unsigned int v : group_extra)
@@ -1083,6 +1131,9 @@ namespace lacerta::cut
       partial_child[t] = child_partial[k] ? stroke : 0;
     }
     child_partial.clear();
+    for (const unsigned int v : verts)
+      if (vertex_scratch[v].star_stamp == star_stamp && v < crossing_pending.size())
+        crossing_pending[v] = 0;
     for (const auto &[pair, f] : stiffness_delta)
     {
       const unsigned int e = mesh.find_edge(pair[0], pair[1]);

@@ -198,9 +198,14 @@ namespace lacerta::cut
       unsigned int point = 0;
     };
 
-    /// One sweep from the last applied crack front to @p end.
+    /// One sweep from the last applied crack front to @p end; at a corner of the
+    /// path, first a sweep that brings the front to the corner.
     void
     sweep(const Blade &end, CutStepStatistics &statistics);
+
+    /// One sweep from the last applied crack front to @p end, a straight motion.
+    void
+    sweep_once(const Blade &end, CutStepStatistics &statistics);
 
     /// FindTetraToCut: fills `candidates` (C) and `next_active` (A_t+1).
     void
@@ -268,6 +273,13 @@ namespace lacerta::cut
     Blade                              current;
     /// The crack front as last applied: the start of the next swept surface.
     Blade front;
+    /// Where the blade was at the end of the last sweep tried: a corner of the path
+    /// when the next motion turns away from the direction since the front.
+    Blade last_end;
+    /// Whether the sweep being made brings the front to a corner, and whether the
+    /// front has not advanced since it reached one: children of these sweeps may be
+    /// thin (the crack bends inside a cell; see has_flat_child()).
+    bool catching_up = false, after_corner = false;
     /// Typical edge length at rest (median), for the sub-division when nothing is active.
     double typical_edge = 0;
     /// The current stroke (from entering the tissue to leaving it), from 1, and
@@ -288,6 +300,9 @@ namespace lacerta::cut
     /// Stroke in which a vertex on the plane was swept by the blade (its patch opens
     /// when all of it is swept).
     std::vector<unsigned int> swept;
+    /// Stroke in which a vertex of the crack lay on the plane ahead of the front (a
+    /// later sweep that reaches it re-splits its star).
+    std::vector<unsigned int> crossing_pending;
     /// Stroke in which a tetrahedron was made by a partial split (not split partially
     /// again while the front is inside it).
     std::vector<unsigned int> partial_child;
