@@ -254,9 +254,10 @@ namespace lacerta
     // (the opened faces and the points where the MT closed the crack at the first
     // tip), so it opens the cells at the old tip too: the slab is in two pieces on the
     // level of detail, at the finest and at a middle level. The finest shows the whole
-    // section (1 x 0.25, both sides; 0.5 m^2 measured on the plane) plus a flap in the
-    // cell row at the old tip, faces from the plane to the next vertex column (0.038
-    // m^2 measured, y in [0.5, 0.625]): at most that row (tip_row) more.
+    // section (1 x 0.25, both sides; 0.5 m^2 measured on the plane, as the cutter
+    // opened it on the level of detail) plus a flap that the second MT update opens in
+    // the cell row at the old tip, faces from the plane to the next vertex column
+    // (0.038 m^2 measured, y in [0.5, 0.625]): at most that row (tip_row) more.
     EXPECT_EQ(cut::count_components(scene->active_mesh()), 2u);
     const mesh::TetMesh through        = extract(mt, 0, 2, "after the second pull");
     const double        through_opened = test_support::boundary_area(through) - slab_area;
