@@ -3,6 +3,7 @@
 #include <lacerta/physics/assembly.h>
 #include <lacerta/physics/particle_system.h>
 
+#include <deal.II/base/exceptions.h>
 #include <deal.II/base/function.h>
 
 #include <algorithm>
@@ -1161,6 +1162,17 @@ namespace lacerta::cut
       if (blade_in_tet(t, end))
         active.push_back(t);
     statistics.changed = true;
+  }
+
+
+  void
+  Cutter::adopt_crack(const std::vector<unsigned int> &crack)
+  {
+    for (const unsigned int v : crack)
+    {
+      AssertIndexRange(v, mesh.n_vertices());
+      mark_on_surface(v);
+    }
   }
 
 

@@ -291,6 +291,17 @@ namespace lacerta::cut
                                           cut_parameters,
                                           blade_at(l, from));
       l.cutter->set_recorder(recorder);
+      // A stopped laceration continued on a new particle system: its particles on its
+      // plane (the opened crack, and the points where the MT closed it inside the cells
+      // at its tip) are the new cutter's crack, so that the cells behind the tip open
+      // when the front passes them instead of staying a bridge (doc/lacerations.md).
+      std::vector<unsigned int> crack;
+      for (unsigned int v = 0; v < sheet.size(); ++v)
+        if (sheet[v] == index
+            && std::abs(dot(l.normal, sub(position(v), l.origin)))
+                 <= cut_parameters.snap_fraction * l.edge)
+          crack.push_back(v);
+      l.cutter->adopt_crack(crack);
     }
     double       u     = from;
     const double exit  = l.end + l.edge;
@@ -484,8 +495,8 @@ namespace lacerta::cut
         s.continued = true;
         find_crossings(l);
         // Without its cutter (the particle system was replaced) a new one starts at
-        // the tip; the cells in which the MT closed the crack stay closed
-        // (doc/lacerations.md, "Limits").
+        // the tip, with the laceration's particles on its plane as its crack
+        // (advance()).
         advance(i, l.stop, l.stop, s);
         s.complete = lacerations[i].complete;
         break;

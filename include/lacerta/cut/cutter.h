@@ -132,6 +132,18 @@ namespace lacerta::cut
       recorder = records;
     }
 
+    /**
+     * Makes the vertices @p crack (on the cut surface of an earlier cutter on this
+     * mesh, e.g. a tear whose particle system was rebuilt) vertices of this stroke's
+     * crack: like the vertices this cutter put on the cut, they join the crack when
+     * the front is past them, whatever the sweep's start, and are not a fresh patch
+     * of vertices on the plane waiting to be swept as a whole. Call before the first
+     * move_blade() of a stroke that continues that crack in its plane; the stroke's
+     * end forgets them.
+     */
+    void
+    adopt_crack(const std::vector<unsigned int> &crack);
+
     /// The active tetrahedra A_t (those the blade is in).
     const std::vector<unsigned int> &
     active_tets() const
