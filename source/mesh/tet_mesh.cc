@@ -549,8 +549,9 @@ namespace lacerta::mesh
     update.moves.clear();
     // Edge ids of the new tets, looked up while the old tets are still in place, so
     // that an edge that survives keeps its id (and its spring). Edges not found are
-    // numbered in the order they first appear; a small hash table of the ones made so
-    // far merges their repetitions.
+    // numbered in the order they first appear. A small hash table of the edges seen
+    // so far (found or made) answers their repetitions (an inner edge of the new
+    // cells appears in several of them) without searching a star again.
     auto &new_edge_ids = scratch.new_edge_ids;
     new_edge_ids.resize(added.size());
     std::size_t table_size = 16;
@@ -564,28 +565,29 @@ namespace lacerta::mesh
         unsigned int a = added[k][edge_vertices[e][0]], b = added[k][edge_vertices[e][1]];
         if (a > b)
           std::swap(a, b);
-        unsigned int id = find_edge(a, b);
-        if (id == invalid_index)
+        unsigned int id = invalid_index;
+        std::size_t  h  = ((std::size_t(a) * 0x9E3779B97F4A7C15ULL)
+                         ^ (std::size_t(b) * 0xC2B2AE3D27D4EB4FULL))
+                        >> 20;
+        for (h &= table_size - 1;; h = (h + 1) & (table_size - 1))
         {
-          std::size_t h = ((std::size_t(a) * 0x9E3779B97F4A7C15ULL)
-                           ^ (std::size_t(b) * 0xC2B2AE3D27D4EB4FULL))
-                          >> 20;
-          for (h &= table_size - 1;; h = (h + 1) & (table_size - 1))
+          auto &slot = created[h];
+          if (slot[2] == invalid_index)
           {
-            auto &slot = created[h];
-            if (slot[2] == invalid_index)
+            id = find_edge(a, b);
+            if (id == invalid_index)
             {
-              id   = static_cast<unsigned int>(edges.size());
-              slot = {{a, b, id}};
+              id = static_cast<unsigned int>(edges.size());
               edges.push_back({{a, b}});
               ++update.n_added;
-              break;
             }
-            if (slot[0] == a && slot[1] == b)
-            {
-              id = slot[2];
-              break;
-            }
+            slot = {{a, b, id}};
+            break;
+          }
+          if (slot[0] == a && slot[1] == b)
+          {
+            id = slot[2];
+            break;
           }
         }
         new_edge_ids[k][e] = id;

@@ -280,7 +280,7 @@ namespace lacerta::mesh
     struct ReplaceScratch
     {
       std::vector<std::array<unsigned int, 6>> new_edge_ids;
-      /// Open-addressing table of the edges created by this update: (a, b, id).
+      /// Open-addressing table of the edges of the new tets seen so far: (a, b, id).
       std::vector<std::array<unsigned int, 3>> created;
       std::vector<std::array<unsigned int, 3>> old_edges;
       std::vector<unsigned int>                dead, refresh, vertex_stamp, edge_stamp;
