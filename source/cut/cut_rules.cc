@@ -34,8 +34,10 @@ namespace lacerta::cut
                 std::vector<unsigned int>   &group)
   {
     // Union-find over the cells; the faces through v are matched by their two other
-    // nodes (sorted), so no map is needed.
-    std::vector<std::size_t> parent(star.size());
+    // nodes (sorted), so no map is needed. The working arrays are kept per thread:
+    // the cutter calls this for every vertex on the cut, and should not allocate.
+    static thread_local std::vector<std::size_t> parent;
+    parent.resize(star.size());
     std::iota(parent.begin(), parent.end(), 0);
     const auto find = [&](std::size_t i)
     {
@@ -49,8 +51,8 @@ namespace lacerta::cut
       std::size_t   cell;
       bool          cut;
     };
-    std::vector<FaceRef> faces;
-    faces.reserve(3 * star.size());
+    static thread_local std::vector<FaceRef> faces;
+    faces.clear();
     for (std::size_t i = 0; i < star.size(); ++i)
     {
       const auto &n = star[i].nodes;
@@ -90,7 +92,8 @@ namespace lacerta::cut
       b = e;
     }
     group.assign(star.size(), 0);
-    std::vector<std::size_t> roots;
+    static thread_local std::vector<std::size_t> roots;
+    roots.clear();
     for (std::size_t i = 0; i < star.size(); ++i)
     {
       const std::size_t root = find(i);

@@ -97,6 +97,22 @@ namespace lacerta::cut
       , last_end(initial)
   {
     mesh.enable_local_updates();
+    // Room for half as much again, so that the cuts of a stroke copy no mesh-sized
+    // array (past it, the arrays double as usual: one copy, amortised).
+    const auto room = [](const std::size_t n)
+    { return static_cast<unsigned int>(n + n / 2 + 4096); };
+    mesh.reserve(room(mesh.n_vertices()), room(mesh.n_tets()));
+    system.reserve(room(system.n_particles()));
+    system.springs.reserve(room(system.springs.size()));
+    vertex_scratch.reserve(room(mesh.n_vertices()));
+    on_surface.reserve(room(mesh.n_vertices()));
+    swept.reserve(room(mesh.n_vertices()));
+    edge_scratch.reserve(room(mesh.n_edges()));
+    edge_stamp.reserve(room(mesh.n_edges()));
+    face_scratch.reserve(4 * room(mesh.n_tets()));
+    tet_mark.reserve(room(mesh.n_tets()));
+    tet_stamp.reserve(room(mesh.n_tets()));
+    partial_child.reserve(room(mesh.n_tets()));
     std::vector<double> lengths;
     for (const auto &e : mesh.get_edges())
       lengths.push_back(norm(sub(mesh.vertex(e[1]), mesh.vertex(e[0]))));
@@ -218,7 +234,6 @@ namespace lacerta::cut
     }
     // Propagation: through the cells around every intersected edge (each edge tested
     // once per sweep), no global search.
-    std::vector<unsigned int> around;
     for (std::size_t q = 0; q < queue.size(); ++q)
     {
       const unsigned int t = queue[q];
@@ -266,7 +281,10 @@ namespace lacerta::cut
       std::max(norm(sub(next.tail, current.tail)), norm(sub(next.head, current.head)));
     if (!(advance > 0))
       return statistics;
+    const auto t_refit = Clock::now();
     tree.refit(mesh, system.position.data());
+    statistics.search_seconds +=
+      std::chrono::duration<double>(Clock::now() - t_refit).count();
     // The local element size: the median edge of the active cells (deformed), or of
     // the mesh when the blade is outside. Not the shortest: cells a cut made small
     // must not multiply the sweeps, each of which re-splits the cells at the front.
@@ -337,7 +355,10 @@ namespace lacerta::cut
     const Blade                              &s               = front;
     const std::array<std::array<Point, 3>, 2> swept_triangles = {
       {{{s.tail, s.head, end.tail}}, {{end.tail, s.head, end.head}}}};
+    const auto t_search = Clock::now();
     find_tets_to_cut(swept_triangles, end);
+    statistics.search_seconds +=
+      std::chrono::duration<double>(Clock::now() - t_search).count();
     active.swap(next_active);
     if (candidates.empty())
     {
@@ -374,6 +395,7 @@ namespace lacerta::cut
     start_reach      = (stroke_has_cut ? start_tolerance : 1.0) * typical_edge;
 
     const auto t_start = Clock::now();
+    lap_start          = t_start;
     const auto spent   = [&]
     {
       statistics.update_seconds +=
@@ -389,6 +411,7 @@ namespace lacerta::cut
     if (!analyse(surface))
     {
       ++statistics.postponed;
+      lap(statistics.analysis_seconds);
       spent();
       return;
     }
@@ -433,6 +456,7 @@ namespace lacerta::cut
         cuts.push_back(c);
       }
     }
+    lap(statistics.analysis_seconds);
     if (removed.empty())
     {
       front = end;
@@ -472,12 +496,14 @@ namespace lacerta::cut
       if (postpone)
       {
         ++statistics.postponed;
+        lap(statistics.split_seconds);
         spent();
         return;
       }
       separates |= kind == CutKind::complete || kind == CutKind::partial;
       any_cut |= kind != CutKind::none && kind != CutKind::touch;
     }
+    lap(statistics.split_seconds);
     if (!separates && !any_cut)
     {
       bool any_edge = false;
@@ -852,9 +878,11 @@ namespace lacerta::cut
   void
   Cutter::apply(const Blade &end, CutStepStatistics &statistics)
   {
-    // Contributions of the tetrahedra that go: masses straight from the particles,
-    // stiffnesses by edge after the mesh update (the edge ids move).
-    stiffness_delta.clear();
+    // Contributions of the tetrahedra that go, straight from the particles and from
+    // the springs of their edges (by edge id, before the mesh update moves the ids;
+    // a spring whose edge dies is retired with it). Every spring gets these terms
+    // first and those of the new tetrahedra after, in the order of the cells.
+    physics::SpringSet &springs = system.springs;
     touched_vertices.clear();
     double integral_delta = 0;
     for (const unsigned int r : removed)
@@ -866,10 +894,12 @@ namespace lacerta::cut
         touched_vertices.push_back(mesh.tet(r)[i]);
         integral_delta -= m[i];
       }
-      const double f = physics::tet_stiffness_factor(mesh, r, youngs_modulus);
-      for (const auto &e : tet_edge_vertices)
-        stiffness_delta.push_back({{{mesh.tet(r)[e[0]], mesh.tet(r)[e[1]]}}, -f});
+      const double f = -physics::tet_stiffness_factor(mesh, r, youngs_modulus);
+      for (const unsigned int e : mesh.tet_edges(r))
+        springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
     }
+
+    lap(statistics.physics_seconds);
 
     // New points, merged across tetrahedra through the edge and face they lie on (one
     // particle per edge and side, per face); state interpolated from the parent (the
@@ -1086,12 +1116,14 @@ namespace lacerta::cut
       b = e;
     }
 
+    lap(statistics.children_seconds);
+
     // The mesh, locally.
     mesh.replace_tets(removed, children, face_ids, added_ids, edge_update);
+    lap(statistics.mesh_seconds);
 
     // Springs follow the edges: appended, moved into retired slots, restiffened.
-    physics::SpringSet &springs = system.springs;
-    const auto         &edges   = mesh.get_edges();
+    const auto &edges = mesh.get_edges();
     for (unsigned int i = 0; i < edge_update.n_added; ++i)
     {
       const unsigned int e = static_cast<unsigned int>(springs.size());
@@ -1123,8 +1155,8 @@ namespace lacerta::cut
         integral_delta += m[i];
       }
       const double f = physics::tet_stiffness_factor(mesh, t, youngs_modulus);
-      for (const auto &e : tet_edge_vertices)
-        stiffness_delta.push_back({{{mesh.tet(t)[e[0]], mesh.tet(t)[e[1]]}}, f});
+      for (const unsigned int e : mesh.tet_edges(t))
+        springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
       for (unsigned int f2 = 0; f2 < 4; ++f2)
         if (mesh.neighbor(t, f2) == mesh::invalid_index)
           tree.add_face(mesh, t, f2);
@@ -1135,12 +1167,6 @@ namespace lacerta::cut
     for (const unsigned int v : verts)
       if (vertex_scratch[v].star_stamp == star_stamp && v < crossing_pending.size())
         crossing_pending[v] = 0;
-    for (const auto &[pair, f] : stiffness_delta)
-    {
-      const unsigned int e = mesh.find_edge(pair[0], pair[1]);
-      if (e != mesh::invalid_index)
-        springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
-    }
     // A vertex that lost all its cells cannot happen (copies take over whole stars),
     // but a mass that rounding left a hair below zero would be nonsense: clamp.
     for (const unsigned int v : touched_vertices)
@@ -1162,6 +1188,16 @@ namespace lacerta::cut
       if (blade_in_tet(t, end))
         active.push_back(t);
     statistics.changed = true;
+    lap(statistics.physics_seconds);
+  }
+
+
+  void
+  Cutter::lap(double &phase)
+  {
+    const auto now = Clock::now();
+    phase += std::chrono::duration<double>(now - lap_start).count();
+    lap_start = now;
   }
 
 

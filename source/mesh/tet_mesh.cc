@@ -442,28 +442,45 @@ namespace lacerta::mesh
   }
 
 
-  unsigned int
-  TetMesh::find_edge_excluding(const unsigned int a,
-                               const unsigned int b,
-                               const unsigned int skip) const
+  void
+  TetMesh::reserve(const unsigned int n_vertices, const unsigned int n_tets)
   {
-    for (const unsigned int t : vertex_tets[a])
-      if (t != skip)
-        for (unsigned int e = 0; e < 6; ++e)
-        {
-          const unsigned int p = tets[t][edge_vertices[e][0]];
-          const unsigned int q = tets[t][edge_vertices[e][1]];
-          if ((p == a && q == b) || (p == b && q == a))
-            return tet_edge_ids[t][e];
-        }
-    return invalid_index;
+    const double growth =
+      tets.empty() ? 1.0 : std::max(1.0, double(n_tets) / double(tets.size()));
+    vertices.reserve(n_vertices);
+    boundary_vertex.reserve(n_vertices);
+    tets.reserve(n_tets);
+    tet_edge_ids.reserve(n_tets);
+    neighbors.reserve(4 * std::size_t(n_tets));
+    edges.reserve(std::size_t(growth * double(edges.size())));
+    // A cut adds boundary faces faster than tetrahedra: twice the proportion.
+    boundary_faces.reserve(std::size_t(2 * growth * double(boundary_faces.size())));
+    if (!vertex_tets.empty())
+    {
+      vertex_tets.reserve(n_vertices);
+      boundary_slot.reserve(4 * std::size_t(n_tets));
+    }
   }
 
 
   unsigned int
   TetMesh::find_edge(const unsigned int a, const unsigned int b) const
   {
-    return find_edge_excluding(a, b, invalid_index);
+    // Any tetrahedron with both ends has the edge: search the smaller star (a vertex
+    // just made by a cut has an empty one).
+    const bool         from_a = vertex_tets[a].size() <= vertex_tets[b].size();
+    const unsigned int u = from_a ? a : b, w = from_a ? b : a;
+    for (const unsigned int t : vertex_tets[u])
+    {
+      const Tet &q = tets[t];
+      for (unsigned int e = 0; e < 6; ++e)
+      {
+        const unsigned int p = q[edge_vertices[e][0]], r = q[edge_vertices[e][1]];
+        if ((p == u && r == w) || (p == w && r == u))
+          return tet_edge_ids[t][e];
+      }
+    }
+    return invalid_index;
   }
 
 
@@ -482,7 +499,9 @@ namespace lacerta::mesh
   TetMesh::add_vertex(const Point3 &x)
   {
     vertices.push_back(x);
-    vertex_tets.emplace_back();
+    // Room for a typical star at once (a vertex made by a cut gets its cells one by
+    // one in replace_tets()).
+    vertex_tets.emplace_back().reserve(16);
     boundary_vertex.push_back(0);
     return static_cast<unsigned int>(vertices.size() - 1);
   }
@@ -525,50 +544,94 @@ namespace lacerta::mesh
                   " tetrahedra cannot be replaced by ",
                   added.size(),
                   ".");
-    update = EdgeUpdate();
+    ReplaceScratch &scratch = replace_scratch;
+    update.n_added          = 0;
+    update.moves.clear();
     // Edge ids of the new tets, looked up while the old tets are still in place, so
-    // that an edge that survives keeps its id (and its spring).
-    std::vector<std::array<unsigned int, 6>> new_edge_ids(added.size());
-    std::vector<std::pair<std::array<unsigned int, 2>, unsigned int>> created;
+    // that an edge that survives keeps its id (and its spring). Edges not found are
+    // numbered in the order they first appear. A small hash table of the edges seen
+    // so far (found or made) answers their repetitions (an inner edge of the new
+    // cells appears in several of them) without searching a star again.
+    auto &new_edge_ids = scratch.new_edge_ids;
+    new_edge_ids.resize(added.size());
+    std::size_t table_size = 16;
+    while (table_size < 12 * added.size())
+      table_size *= 2;
+    auto &created = scratch.created;
+    created.assign(table_size, {{invalid_index, invalid_index, invalid_index}});
     for (std::size_t k = 0; k < added.size(); ++k)
       for (unsigned int e = 0; e < 6; ++e)
       {
         unsigned int a = added[k][edge_vertices[e][0]], b = added[k][edge_vertices[e][1]];
         if (a > b)
           std::swap(a, b);
-        unsigned int id = find_edge(a, b);
-        if (id == invalid_index)
+        unsigned int id = invalid_index;
+        std::size_t  h  = ((std::size_t(a) * 0x9E3779B97F4A7C15ULL)
+                         ^ (std::size_t(b) * 0xC2B2AE3D27D4EB4FULL))
+                        >> 20;
+        for (h &= table_size - 1;; h = (h + 1) & (table_size - 1))
         {
-          const auto found = std::find_if(created.begin(),
-                                          created.end(),
-                                          [&](const auto &c)
-                                          { return c.first[0] == a && c.first[1] == b; });
-          if (found != created.end())
-            id = found->second;
-          else
+          auto &slot = created[h];
+          if (slot[2] == invalid_index)
           {
-            id = static_cast<unsigned int>(edges.size());
-            edges.push_back({{a, b}});
-            created.push_back({{{a, b}}, id});
-            ++update.n_added;
+            id = find_edge(a, b);
+            if (id == invalid_index)
+            {
+              id = static_cast<unsigned int>(edges.size());
+              edges.push_back({{a, b}});
+              ++update.n_added;
+            }
+            slot = {{a, b, id}};
+            break;
+          }
+          if (slot[0] == a && slot[1] == b)
+          {
+            id = slot[2];
+            break;
           }
         }
         new_edge_ids[k][e] = id;
       }
 
-    // Take the old tets out: stars, boundary faces, neighbours' back links.
-    std::vector<std::array<unsigned int, 3>> old_edges; // a, b, id
+    // Vertices whose boundary flag may change: those of the old and the new tets.
+    if (++scratch.stamp == 0)
+    {
+      std::fill(scratch.vertex_stamp.begin(), scratch.vertex_stamp.end(), 0u);
+      std::fill(scratch.edge_stamp.begin(), scratch.edge_stamp.end(), 0u);
+      scratch.stamp = 1;
+    }
+    scratch.vertex_stamp.resize(vertices.size(), 0);
+    scratch.refresh.clear();
+    const auto note_vertex = [&](const unsigned int v)
+    {
+      if (scratch.vertex_stamp[v] != scratch.stamp)
+      {
+        scratch.vertex_stamp[v] = scratch.stamp;
+        scratch.refresh.push_back(v);
+      }
+    };
+
+    // Take the old tets out: stars, boundary faces, neighbours' back links. Their
+    // edges, once each (an edge id names one edge), are candidates for retirement.
+    auto &old_edges = scratch.old_edges;
+    old_edges.clear();
+    scratch.edge_stamp.resize(edges.size(), 0);
     for (const unsigned int r : removed)
     {
       for (unsigned int e = 0; e < 6; ++e)
       {
+        const unsigned int id = tet_edge_ids[r][e];
+        if (scratch.edge_stamp[id] == scratch.stamp)
+          continue;
+        scratch.edge_stamp[id] = scratch.stamp;
         unsigned int a = tets[r][edge_vertices[e][0]], b = tets[r][edge_vertices[e][1]];
-        old_edges.push_back({{std::min(a, b), std::max(a, b), tet_edge_ids[r][e]}});
+        old_edges.push_back({{std::min(a, b), std::max(a, b), id}});
       }
       for (const unsigned int v : tets[r])
       {
         auto &star = vertex_tets[v];
         star.erase(std::find(star.begin(), star.end(), r));
+        note_vertex(v);
       }
       for (unsigned int f = 0; f < 4; ++f)
       {
@@ -581,8 +644,6 @@ namespace lacerta::mesh
         neighbors[4 * r + f] = invalid_index;
       }
     }
-    std::sort(old_edges.begin(), old_edges.end());
-    old_edges.erase(std::unique(old_edges.begin(), old_edges.end()), old_edges.end());
 
     // Put the new tets in.
     added_ids.resize(added.size());
@@ -603,10 +664,13 @@ namespace lacerta::mesh
       tets[slot]         = added[k];
       tet_edge_ids[slot] = new_edge_ids[k];
       for (const unsigned int v : added[k])
+      {
         vertex_tets[v].push_back(slot);
+        note_vertex(v);
+      }
     }
-    // Neighbours: the tet sharing a face is in the star of the face's vertices.
-    std::vector<std::pair<unsigned int, unsigned int>> open_faces;
+    // Neighbours: the tet sharing a face is in the star of each of the face's
+    // vertices (the caller guarantees there is at most one): search the smallest.
     for (std::size_t k = 0; k < added.size(); ++k)
     {
       const unsigned int t = added_ids[k];
@@ -614,22 +678,25 @@ namespace lacerta::mesh
       {
         if (neighbors[4 * t + f] != invalid_index)
           continue;
-        const unsigned int a = tets[t][face_vertices[f][0]],
-                           b = tets[t][face_vertices[f][1]],
-                           c = tets[t][face_vertices[f][2]];
+        unsigned int v[3] = {tets[t][face_vertices[f][0]],
+                             tets[t][face_vertices[f][1]],
+                             tets[t][face_vertices[f][2]]};
+        for (unsigned int i = 1; i < 3; ++i)
+          if (vertex_tets[v[i]].size() < vertex_tets[v[0]].size())
+            std::swap(v[0], v[i]);
         unsigned int other = invalid_index, other_face = 0;
-        for (const unsigned int s : vertex_tets[a])
+        for (const unsigned int s : vertex_tets[v[0]])
         {
           if (s == t)
             continue;
           const Tet &q   = tets[s];
-          const auto has = [&](unsigned int v)
-          { return std::find(q.begin(), q.end(), v) != q.end(); };
-          if (has(b) && has(c))
+          const auto has = [&](unsigned int w)
+          { return q[0] == w || q[1] == w || q[2] == w || q[3] == w; };
+          if (has(v[1]) && has(v[2]))
           {
             other = s;
             for (unsigned int g = 0; g < 4; ++g)
-              if (q[g] != a && q[g] != b && q[g] != c)
+              if (q[g] != v[0] && q[g] != v[1] && q[g] != v[2])
                 other_face = g;
             break;
           }
@@ -647,7 +714,8 @@ namespace lacerta::mesh
 
     // Retire the edges no tetrahedron uses any more, largest id first, so that the
     // last slot moved into a hole is always a live edge.
-    std::vector<unsigned int> dead;
+    auto &dead = scratch.dead;
+    dead.clear();
     for (const auto &e : old_edges)
       if (find_edge(e[0], e[1]) == invalid_index)
         dead.push_back(e[2]);
@@ -667,8 +735,8 @@ namespace lacerta::mesh
       edges.pop_back();
     }
 
-    // Boundary flags of every vertex involved, and the touched edges by final id.
-    const auto refresh_vertex = [&](const unsigned int v)
+    // Boundary flags of every vertex involved, once each.
+    for (const unsigned int v : scratch.refresh)
     {
       if (v >= boundary_vertex.size())
         boundary_vertex.resize(v + 1, 0);
@@ -678,24 +746,6 @@ namespace lacerta::mesh
           if (neighbors[4 * t + f] == invalid_index && tets[t][f] != v)
             on_boundary = 1;
       boundary_vertex[v] = on_boundary;
-    };
-    for (const auto &e : old_edges)
-    {
-      refresh_vertex(e[0]);
-      refresh_vertex(e[1]);
-      const unsigned int id = find_edge(e[0], e[1]);
-      if (id != invalid_index)
-        update.touched.push_back(id);
     }
-    for (std::size_t k = 0; k < added.size(); ++k)
-    {
-      for (const unsigned int v : added[k])
-        refresh_vertex(v);
-      for (const unsigned int id : tet_edge_ids[added_ids[k]])
-        update.touched.push_back(id);
-    }
-    std::sort(update.touched.begin(), update.touched.end());
-    update.touched.erase(std::unique(update.touched.begin(), update.touched.end()),
-                         update.touched.end());
   }
 } // namespace lacerta::mesh

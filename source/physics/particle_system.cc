@@ -45,6 +45,16 @@ namespace lacerta::physics
 
 
   void
+  ParticleSystem::reserve(const unsigned int n)
+  {
+    for (std::vector<double> *v : {&position, &velocity, &external_force, &rest})
+      v->reserve(3 * std::size_t(n));
+    mass.reserve(n);
+    free.reserve(n);
+  }
+
+
+  void
   ParticleSystem::update_force_model(const unsigned int n_threads)
   {
     force_threads = n_threads;

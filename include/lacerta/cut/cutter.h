@@ -15,6 +15,7 @@
 #include <deal.II/base/parameter_handler.h>
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <vector>
 
@@ -47,6 +48,18 @@ namespace lacerta::cut
     /// Wall time of the local mesh and physics update, and of the force model's
     /// re-initialisation (global: it repartitions the springs), in seconds.
     double update_seconds = 0, reinit_seconds = 0;
+    /**
+     * Where the time went, in seconds. `search_seconds` (not part of update_seconds):
+     * the boundary face tree's refit, the first contact and the propagation
+     * (FindTetraToCut). The parts of update_seconds: `analysis_seconds` (sides, cut
+     * edges, front points, the closure of the affected set, one TetCut per cell),
+     * `split_seconds` (the split table and the checks that postpone a sweep),
+     * `children_seconds` (the children's nodes, new particles, copies of the vertices
+     * on the cut), `mesh_seconds` (TetMesh::replace_tets()) and `physics_seconds`
+     * (masses, springs, the tree's new faces, the active set).
+     */
+    double search_seconds = 0, analysis_seconds = 0, split_seconds = 0,
+           children_seconds = 0, mesh_seconds = 0, physics_seconds = 0;
     /// Whether the mesh changed (then the integrator must be re-initialised).
     bool changed = false;
     /**
@@ -276,6 +289,10 @@ namespace lacerta::cut
     void
     mark_on_surface(unsigned int v);
 
+    /// Adds the time since the last lap to @p phase (per-phase statistics).
+    void
+    lap(double &phase);
+
     mesh::TetMesh                     &mesh;
     physics::ParticleSystem           &system;
     const dealii::Function<3, double> &density;
@@ -327,16 +344,17 @@ namespace lacerta::cut
     unsigned int analysis_stamp = 0, star_stamp = 0, affected_stamp = 0, merge_stamp = 0;
     std::vector<unsigned int> affected, verts, edge_list, group, group_extra, missing,
       around, removed, added_ids, touched_vertices, star_group, copy_ids;
-    std::vector<TetCut>                                         cuts;
-    std::vector<SplitResult>                                    results;
-    std::vector<mesh::Tet>                                      children;
-    std::vector<std::uint8_t>                                   child_cut_faces;
-    std::vector<bool>                                           child_partial;
-    std::vector<std::array<unsigned int, 4>>                    face_ids;
-    std::vector<std::array<unsigned int, 2>>                    incidences;
-    std::vector<StarCell>                                       star;
-    std::vector<std::pair<std::array<unsigned int, 2>, double>> stiffness_delta;
-    mesh::TetMesh::EdgeUpdate                                   edge_update;
+    std::vector<TetCut>                      cuts;
+    std::vector<SplitResult>                 results;
+    std::vector<mesh::Tet>                   children;
+    std::vector<std::uint8_t>                child_cut_faces;
+    std::vector<bool>                        child_partial;
+    std::vector<std::array<unsigned int, 4>> face_ids;
+    std::vector<std::array<unsigned int, 2>> incidences;
+    std::vector<StarCell>                    star;
+    mesh::TetMesh::EdgeUpdate                edge_update;
+    /// The end of the last lap().
+    std::chrono::steady_clock::time_point lap_start;
     /// Where sweeps are recorded (set_recorder()), or nullptr.
     std::vector<CutRecord> *recorder = nullptr;
     /// Per child of the sweep being applied, when recording: (split, child of the split).

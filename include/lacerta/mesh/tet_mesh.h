@@ -192,14 +192,12 @@ namespace lacerta::mesh
      * What replace_tets() did to the unique edges, so that arrays indexed by edge id
      * (the springs) can follow: first `n_added` edges were appended, then every pair
      * (to, from) of `moves`, in order, copied edge `from` (the last one) into slot `to`
-     * and dropped the last slot. `touched` holds the final ids of every edge whose
-     * incident tetrahedra changed (new edges and surviving edges of removed tets).
+     * and dropped the last slot.
      */
     struct EdgeUpdate
     {
       unsigned int                             n_added = 0;
       std::vector<std::array<unsigned int, 2>> moves;
-      std::vector<unsigned int>                touched;
     };
 
     /**
@@ -209,6 +207,15 @@ namespace lacerta::mesh
      */
     void
     enable_local_updates();
+
+    /**
+     * Makes room for @p n_vertices vertices and @p n_tets tetrahedra (edges and
+     * boundary faces in proportion), so that add_vertex() and replace_tets() copy no
+     * array while the mesh stays within that size: a local update then costs nothing
+     * proportional to the mesh.
+     */
+    void
+    reserve(unsigned int n_vertices, unsigned int n_tets);
 
     /// Whether enable_local_updates() was called.
     bool
@@ -267,9 +274,18 @@ namespace lacerta::mesh
                  EdgeUpdate                                     &edge_update);
 
   private:
-    /// Edge id of (a, b) in a tetrahedron of the star of a other than @p skip.
-    unsigned int
-    find_edge_excluding(unsigned int a, unsigned int b, unsigned int skip) const;
+    /// Working arrays of replace_tets(), kept so that an update allocates nothing
+    /// once they have grown; `vertex_stamp` (per vertex) and `edge_stamp` (per edge id)
+    /// mark the vertices and old edges seen by the current update.
+    struct ReplaceScratch
+    {
+      std::vector<std::array<unsigned int, 6>> new_edge_ids;
+      /// Open-addressing table of the edges of the new tets seen so far: (a, b, id).
+      std::vector<std::array<unsigned int, 3>> created;
+      std::vector<std::array<unsigned int, 3>> old_edges;
+      std::vector<unsigned int>                dead, refresh, vertex_stamp, edge_stamp;
+      unsigned int                             stamp = 0;
+    };
 
     /// Removes boundary face (t, f) if it is one.
     void
@@ -296,6 +312,7 @@ namespace lacerta::mesh
     std::vector<BoundaryFace>                boundary_faces;
     std::vector<std::uint8_t>                boundary_vertex;
     std::string                              source_name;
+    ReplaceScratch                           replace_scratch;
   };
 
   /**

@@ -66,6 +66,13 @@ namespace lacerta::physics
       return static_cast<unsigned int>(mass.size());
     }
 
+    /**
+     * Makes room for @p n particles, so that add_particle() up to that many copies
+     * no array (the cutter adds particles in its local updates).
+     */
+    void
+    reserve(unsigned int n);
+
     /// Sets the force model; it is initialised for the current springs.
     void
     set_force_model(std::unique_ptr<ForceModel> model, unsigned int n_threads);

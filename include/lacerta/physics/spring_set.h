@@ -38,6 +38,17 @@ namespace lacerta::physics
       rest_length.push_back(length);
     }
 
+    /// Makes room for @p n springs, so that appending up to that many reallocates
+    /// nothing.
+    void
+    reserve(std::size_t n)
+    {
+      a.reserve(n);
+      b.reserve(n);
+      stiffness.reserve(n);
+      rest_length.reserve(n);
+    }
+
     /// Removes all springs.
     void
     clear()
