@@ -64,6 +64,21 @@ namespace lacerta::physics
     void
     check(const ParticleSystem &system, unsigned int step, double time);
 
+    /**
+     * Continues watching after the particles and springs of the system were replaced
+     * (a cut, a tear, a new level of detail, an MT update), then checks the new state
+     * like check(). The energy ledger carries over: energy that the change removed
+     * (cut springs) is forgotten, energy that it added counts as growth, so that a
+     * blow-up is caught even if the system changes at every step, and a change that
+     * itself puts particles far off stops the run. @p cause names the change for the
+     * message.
+     */
+    void
+    restart(const ParticleSystem &system,
+            unsigned int          step,
+            double                time,
+            const std::string    &cause);
+
     /// Work done on the system by prescribed motions and external forces so far (J).
     double
     input_work() const
@@ -76,6 +91,21 @@ namespace lacerta::physics
     /// state.
     void
     compute_load_forces(const ParticleSystem &system);
+
+    /// Throws if a position or velocity is not finite; @p after names a change or is
+    /// empty.
+    void
+    check_finite(const ParticleSystem &system,
+                 unsigned int          step,
+                 double                time,
+                 const std::string    &after) const;
+
+    /// Throws if the energy exceeds the ledger by more than the tolerance.
+    void
+    check_energy(const ParticleSystem &system,
+                 unsigned int          step,
+                 double                time,
+                 const std::string    &after) const;
 
     double              tolerance;
     double              initial_energy;
