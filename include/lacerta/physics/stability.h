@@ -66,12 +66,10 @@ namespace lacerta::physics
 
     /**
      * Continues watching after the particles and springs of the system were replaced
-     * (a cut, a tear, a new level of detail, an MT update), then checks the new state
-     * like check(). The energy ledger carries over: energy that the change removed
-     * (cut springs) is forgotten, energy that it added counts as growth, so that a
-     * blow-up is caught even if the system changes at every step, and a change that
-     * itself puts particles far off stops the run. @p cause names the change for the
-     * message.
+     * (a cut, a tear, a new level of detail, an MT update): checks the new state
+     * against the ledger so far (a change that puts particles far off stops the run,
+     * the message naming @p cause), then starts the ledger again from the new state,
+     * keeping the largest energy seen as the scale.
      */
     void
     restart(const ParticleSystem &system,
