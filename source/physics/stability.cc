@@ -165,9 +165,10 @@ namespace lacerta::physics
 
 
   void
-  BlowUpMonitor::check(const ParticleSystem &system,
-                       const unsigned int    step,
-                       const double          time)
+  BlowUpMonitor::check_finite(const ParticleSystem &system,
+                              const unsigned int    step,
+                              const double          time,
+                              const std::string    &after) const
   {
     for (unsigned int i = 0; i < system.n_particles(); ++i)
       for (unsigned int d = 0; d < 3; ++d)
@@ -177,25 +178,30 @@ namespace lacerta::physics
                       step,
                       ", time ",
                       time,
-                      " s: ",
+                      " s",
+                      after,
+                      ": ",
                       describe_particle(system, i),
                       " has a position or velocity that is not a finite number. Reduce "
                       "'Time step' or raise 'Stability/Safety factor' margin.");
+  }
 
-    compute_load_forces(system);
-    const std::vector<double> &x = system.position;
-    for (std::size_t c = 0; c < x.size(); ++c)
-      work += 0.5 * (previous_load[c] + load[c]) * (x[c] - previous_position[c]);
-    previous_position = x;
-    previous_load     = load;
 
-    const double kinetic = system.kinetic_energy();
-    const double elastic = system.elastic_energy();
-    const double body    = system.body_force_energy();
-    energy_scale =
-      std::max(energy_scale, kinetic + elastic + std::abs(body) + std::abs(work));
-    const double excess = kinetic + elastic + body - initial_energy - work;
-    if (excess > tolerance * energy_scale + energy_floor && excess > energy_floor)
+  void
+  BlowUpMonitor::check_energy(const ParticleSystem &system,
+                              const unsigned int    step,
+                              const double          time,
+                              const std::string    &after) const
+  {
+    const double energy =
+      system.kinetic_energy() + system.elastic_energy() + system.body_force_energy();
+    const double excess = energy - initial_energy - work;
+    // The scale: the largest energy of the states already accepted, or the energy the
+    // system may have now, not the energy under test.
+    const double scale =
+      std::max(energy_scale, std::abs(initial_energy) + std::abs(work));
+    // Written so that a NaN energy (an infinite spring force) also stops the run.
+    if (!(excess <= tolerance * scale + energy_floor || excess <= energy_floor))
     {
       unsigned int fastest = 0;
       double       speed   = 0;
@@ -213,8 +219,10 @@ namespace lacerta::physics
                   step,
                   ", time ",
                   time,
-                  " s: the mechanical energy (",
-                  kinetic + elastic + body,
+                  " s",
+                  after,
+                  ": the mechanical energy (",
+                  energy,
                   " J) exceeds the initial energy plus the work of the loads (",
                   initial_energy + work,
                   " J) by ",
@@ -225,5 +233,64 @@ namespace lacerta::physics
                   speed,
                   " m/s. Reduce 'Time step' or add damping.");
     }
+  }
+
+
+  void
+  BlowUpMonitor::check(const ParticleSystem &system,
+                       const unsigned int    step,
+                       const double          time)
+  {
+    check_finite(system, step, time, "");
+
+    compute_load_forces(system);
+    const std::vector<double> &x = system.position;
+    for (std::size_t c = 0; c < x.size(); ++c)
+      work += 0.5 * (previous_load[c] + load[c]) * (x[c] - previous_position[c]);
+    previous_position = x;
+    previous_load     = load;
+
+    // The scale is the largest energy of the states already accepted: had it included
+    // the state under test, the excess could never exceed it with a tolerance of 1
+    // (the default), and a run reached 1e127 J unstopped.
+    check_energy(system, step, time, "");
+    const double kinetic = system.kinetic_energy();
+    const double elastic = system.elastic_energy();
+    const double body    = system.body_force_energy();
+    energy_scale =
+      std::max(energy_scale, kinetic + elastic + std::abs(body) + std::abs(work));
+  }
+
+
+  void
+  BlowUpMonitor::restart(const ParticleSystem &system,
+                         const unsigned int    step,
+                         const double          time,
+                         const std::string    &cause)
+  {
+    const std::string after = " (right after " + cause + ")";
+    check_finite(system, step, time, after);
+    const double energy =
+      system.kinetic_energy() + system.elastic_energy() + system.body_force_energy();
+    double spring_energy = 0;
+    for (std::size_t s = 0; s < system.springs.size(); ++s)
+      spring_energy += system.springs.stiffness[s] * system.springs.rest_length[s]
+                       * system.springs.rest_length[s];
+    energy_floor = std::max(energy_floor, 1e-12 * spring_energy);
+    check_energy(system, step, time, after);
+    energy_scale = std::max(energy_scale,
+                            system.kinetic_energy() + system.elastic_energy()
+                              + std::abs(system.body_force_energy()));
+    // The ledger starts again from the new state: the work of the loads since the
+    // last check is lost with the old particles, and carrying an excess over many
+    // changes (a stroke changes the system at every step) accumulated that loss into
+    // false alarms.
+    initial_energy    = energy;
+    work              = 0;
+    previous_position = system.position;
+    previous_load.assign(system.position.size(), 0.0);
+    load.assign(system.position.size(), 0.0);
+    compute_load_forces(system);
+    previous_load = load;
   }
 } // namespace lacerta::physics

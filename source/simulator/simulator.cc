@@ -171,6 +171,14 @@ namespace lacerta
                       "initial energy plus the work of the loads by this fraction of the "
                       "largest energy seen.");
     prm.declare_entry(
+      "Maximum sub-steps",
+      "1000",
+      dealii::Patterns::Integer(1, 1000000000),
+      "With 'Time step above limit' = substep, the run stops instead of splitting a "
+      "step into more sub-steps than this: a critical time step that small comes "
+      "from a degenerate element (a sliver, a particle far off), not from the "
+      "material, and the run would crawl.");
+    prm.declare_entry(
       "Check interval",
       "10",
       dealii::Patterns::Integer(1, 1000000),
@@ -251,6 +259,7 @@ namespace lacerta
     safety_factor         = prm.get_double("Safety factor");
     energy_tolerance      = prm.get_double("Energy growth tolerance");
     check_interval        = prm.get_integer("Check interval");
+    max_substeps          = prm.get_integer("Maximum sub-steps");
     prm.leave_subsection();
 
     std::error_code error;
@@ -280,6 +289,11 @@ namespace lacerta
     const physics::FrequencyBound  bound  = physics::bound_highest_frequency(system);
     if (bound.omega == 0)
       return 1;
+    if (!std::isfinite(bound.omega))
+      throw_error("The simulation blew up: the bound on the highest eigenfrequency is "
+                  "not finite at ",
+                  physics::describe_spring(system, bound.spring),
+                  ".");
     const double critical = integrator->critical_time_step(bound.omega,
                                                            system.mass_damping,
                                                            system.spring_damping);
@@ -308,10 +322,38 @@ namespace lacerta
         " s). The limit is set by ",
         physics::describe_spring(system, bound.spring),
         ". Reduce 'Time step' or set 'Stability/Time step above limit' = substep.");
-    const unsigned int n = static_cast<unsigned int>(std::ceil(time_step / allowed));
+    const double n_needed = std::ceil(time_step / allowed);
+    if (n_needed > max_substeps)
+      throw_error("The simulation blew up: 'Time step' = ",
+                  time_step,
+                  " s would need ",
+                  n_needed,
+                  " sub-steps (more than 'Stability/Maximum sub-steps' = ",
+                  max_substeps,
+                  ") to stay below the critical time step ",
+                  critical,
+                  " s, which is set by ",
+                  physics::describe_spring(system, bound.spring),
+                  ". A limit that small comes from a degenerate element or a particle "
+                  "far off, not from the material.");
+    const unsigned int n = static_cast<unsigned int>(n_needed);
     std::cout << "Stability: each step is split into " << n << " sub-steps of "
               << time_step / n << " s\n";
     return n;
+  }
+
+
+  bool
+  Simulator::needs_more_substeps(const unsigned int substeps) const
+  {
+    const physics::ParticleSystem &system = *scene->system;
+    const physics::FrequencyBound  bound  = physics::bound_highest_frequency(system);
+    if (bound.omega == 0)
+      return false;
+    const double critical = integrator->critical_time_step(bound.omega,
+                                                           system.mass_damping,
+                                                           system.spring_damping);
+    return !(time_step / substeps <= safety_factor * critical);
   }
 
 
@@ -365,13 +407,19 @@ namespace lacerta
     // others: the integrator's scratch space, the stability limit and the energy
     // baseline of the blow-up monitor start afresh (the invariants are checked first
     // if @p check_now).
-    const auto system_changed = [&](const unsigned int step, const bool check_now)
+    // The monitor carries its energy ledger over the change and checks the new state
+    // at once: a change at every step must not hide a blow-up, and a change that puts
+    // particles far off must stop the run naming it (@p cause).
+    const auto system_changed = [&](const unsigned int step,
+                                    const double       at,
+                                    const bool         check_now,
+                                    const std::string &cause)
     {
       if (check_now)
         check(step);
       integrator->initialize(system);
+      monitor.restart(system, step, at, cause);
       substeps = state.substeps = choose_substeps();
-      monitor                   = physics::BlowUpMonitor(system, energy_tolerance);
       state.mesh                = &scene->active_mesh();
     };
     const auto evaluate_energies = [&]
@@ -390,7 +438,14 @@ namespace lacerta
         needs_energies |= p->needs_energies(state.time);
       }
       if (writes || step % check_interval == 0)
+      {
         monitor.check(system, step, state.time);
+        // The limit falls when an element collapses (the geometric stiffness of a
+        // strongly compressed spring) without any change of the system: keeping the
+        // sub-steps chosen at the last change let the severed kidney pole blow up.
+        if (substep_when_unstable && needs_more_substeps(substeps))
+          substeps = state.substeps = choose_substeps();
+      }
       if (needs_energies)
       {
         evaluate_energies();
@@ -440,7 +495,7 @@ namespace lacerta
         {
           // The constraints take over the copies of their particles.
           scene->follow_cut(cut.copied_particles);
-          system_changed(step, true);
+          system_changed(step, time, true, "the cut");
         }
       }
       if (scene->lacerator)
@@ -481,7 +536,7 @@ namespace lacerta
           // As after a cut; the scalpel's search structures must see the torn faces.
           scene->follow_cut(tear.copied_particles);
           scene->restart_cutter();
-          system_changed(step, true);
+          system_changed(step, time, true, "the laceration");
         }
       }
       const auto   relax_start = Clock::now();
@@ -535,10 +590,10 @@ namespace lacerta
                   << " (the cutter's mesh had " << mt_cut->pieces_before << ")\n";
         stroke_cut = stroke_created = 0;
         stroke_update               = 0;
-        system_changed(step, true);
+        system_changed(step, time, true, "the MT update after the stroke");
       }
       if (scene->update_level_of_detail(time, step, std::cout))
-        system_changed(step, false);
+        system_changed(step, time, false, "the re-extraction of the level of detail");
       state.step          = step;
       state.time          = time;
       state.time_step     = dt;

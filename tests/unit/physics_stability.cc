@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "physics_test_support.h"
+#include <limits>
 #include <random>
 
 using namespace lacerta;
@@ -255,6 +256,80 @@ TEST(Stability, MonitorAcceptsAStableDampedRunWithWorkInput)
       EXPECT_NO_THROW(monitor.check(*system, step, step * dt));
   }
   EXPECT_GT(monitor.input_work(), 0.0);
+}
+
+
+TEST(Stability, MonitorCatchesFiniteEnergyGrowthWithTheDefaultTolerance)
+{
+  // A box swinging with some kinetic energy; its velocities then grow tenfold (energy
+  // x100, still finite). The energy scale once included the state under test, so that
+  // with the default tolerance 1 this passed (a kidney_cut variant reached 1e127 J).
+  const mesh::TetMesh mesh =
+    test_support::distorted_box(2, 0.0, dealii::Point<3>(0.1, 0.03, 0.03));
+  auto system = test_support::make_system(mesh, 1000, 1e5);
+  for (unsigned int i = 0; i < system->n_particles(); ++i)
+    system->velocity[3 * i + 1] = 0.01 * system->position[3 * i];
+  physics::BlowUpMonitor monitor(*system, 1.0);
+  EXPECT_NO_THROW(monitor.check(*system, 1, 1e-3));
+  for (double &v : system->velocity)
+    v *= 10;
+  try
+  {
+    monitor.check(*system, 2, 2e-3);
+    ADD_FAILURE() << "a hundredfold energy growth was not caught";
+  }
+  catch (const Error &e)
+  {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("blew up at step 2, time 0.002 s"), std::string::npos)
+      << message;
+    EXPECT_NE(message.find("mechanical energy"), std::string::npos) << message;
+  }
+}
+
+
+TEST(Stability, MonitorCarriesItsLedgerOverASystemChange)
+{
+  // A change that removes energy passes and the ledger restarts from it; one that
+  // adds energy (as a state transfer putting particles far off would) stops the run
+  // naming the change.
+  const mesh::TetMesh mesh =
+    test_support::distorted_box(2, 0.0, dealii::Point<3>(0.1, 0.03, 0.03));
+  auto system = test_support::make_system(mesh, 1000, 1e5);
+  for (unsigned int i = 0; i < system->n_particles(); ++i)
+    system->velocity[3 * i + 1] = 0.01 * system->position[3 * i];
+  physics::BlowUpMonitor monitor(*system, 1.0);
+  for (double &v : system->velocity)
+    v *= 0.5;
+  EXPECT_NO_THROW(monitor.restart(*system, 1, 1e-3, "the cut"));
+  // Four times the initial energy, sixteen times the ledger after the loss: caught.
+  for (double &v : system->velocity)
+    v *= 4;
+  try
+  {
+    monitor.restart(*system, 2, 2e-3, "the re-extraction of the level of detail");
+    ADD_FAILURE() << "the energy added by the change was not caught";
+  }
+  catch (const Error &e)
+  {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("right after the re-extraction of the level of detail"),
+              std::string::npos)
+      << message;
+  }
+  // Non-finite values after a change are named too.
+  system->position[4] = std::numeric_limits<double>::quiet_NaN();
+  try
+  {
+    monitor.restart(*system, 3, 3e-3, "the MT update after the stroke");
+    ADD_FAILURE() << "a NaN position was not caught";
+  }
+  catch (const Error &e)
+  {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("not a finite number"), std::string::npos) << message;
+    EXPECT_NE(message.find("right after the MT update"), std::string::npos) << message;
+  }
 }
 
 

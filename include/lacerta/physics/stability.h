@@ -64,6 +64,19 @@ namespace lacerta::physics
     void
     check(const ParticleSystem &system, unsigned int step, double time);
 
+    /**
+     * Continues watching after the particles and springs of the system were replaced
+     * (a cut, a tear, a new level of detail, an MT update): checks the new state
+     * against the ledger so far (a change that puts particles far off stops the run,
+     * the message naming @p cause), then starts the ledger again from the new state,
+     * keeping the largest energy seen as the scale.
+     */
+    void
+    restart(const ParticleSystem &system,
+            unsigned int          step,
+            double                time,
+            const std::string    &cause);
+
     /// Work done on the system by prescribed motions and external forces so far (J).
     double
     input_work() const
@@ -76,6 +89,21 @@ namespace lacerta::physics
     /// state.
     void
     compute_load_forces(const ParticleSystem &system);
+
+    /// Throws if a position or velocity is not finite; @p after names a change or is
+    /// empty.
+    void
+    check_finite(const ParticleSystem &system,
+                 unsigned int          step,
+                 double                time,
+                 const std::string    &after) const;
+
+    /// Throws if the energy exceeds the ledger by more than the tolerance.
+    void
+    check_energy(const ParticleSystem &system,
+                 unsigned int          step,
+                 double                time,
+                 const std::string    &after) const;
 
     double              tolerance;
     double              initial_energy;

@@ -78,16 +78,23 @@ namespace lacerta
     unsigned int
     choose_substeps();
 
-    std::string                                              output_directory;
-    double                                                   end_time;
-    double                                                   time_step;
-    unsigned int                                             n_threads;
-    bool                                                     test_mode;
-    bool                                                     check_invariants;
-    bool                                                     substep_when_unstable;
-    double                                                   safety_factor;
-    double                                                   energy_tolerance;
-    unsigned int                                             check_interval;
+    /// Whether @p substeps sub-steps per step are no longer below the stability limit
+    /// of the current state.
+    bool
+    needs_more_substeps(unsigned int substeps) const;
+
+    std::string  output_directory;
+    double       end_time;
+    double       time_step;
+    unsigned int n_threads;
+    bool         test_mode;
+    bool         check_invariants;
+    bool         substep_when_unstable;
+    double       safety_factor;
+    double       energy_tolerance;
+    unsigned int check_interval;
+    /// 'Stability/Maximum sub-steps': more sub-steps per step stop the run.
+    unsigned int                                             max_substeps;
     std::unique_ptr<scene::Scene>                            scene;
     std::unique_ptr<physics::Integrator>                     integrator;
     std::vector<std::unique_ptr<postprocess::Postprocessor>> postprocessors;
