@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
 
 namespace lacerta::mt
 {
@@ -205,29 +204,37 @@ namespace lacerta::mt
       return std::make_pair(best, best_inside);
     };
     CutTransferReport         report;
-    std::vector<unsigned int> candidates;
+    std::vector<unsigned int> candidates, votes;
     x.assign(3 * to.n_vertices(), 0.0);
     v.assign(3 * to.n_vertices(), 0.0);
     for (unsigned int w = 0; w < to.n_vertices(); ++w)
     {
       const mesh::Point3 &rest = to.vertex(w);
       const mesh::Point3  star = star_centre(to, around_to, w);
-      // w's side: the old piece holding most centroids of its tetrahedra.
-      std::map<unsigned int, unsigned int> votes;
+      // w's side: the old piece holding most centroids of its tetrahedra (ties: the
+      // lowest piece id).
+      votes.clear();
       for (unsigned int k = around_to.first[w]; k < around_to.first[w + 1]; ++k)
       {
         const unsigned int found =
           locate(centroid(to, around_to.incident[k]), mesh::invalid_index).first;
         if (found != mesh::invalid_index)
-          ++votes[piece_from[found]];
+          votes.push_back(piece_from[found]);
       }
+      std::sort(votes.begin(), votes.end());
       unsigned int piece = mesh::invalid_index, most = 0;
-      for (const auto &[p, n] : votes)
-        if (n > most)
+      for (std::size_t i = 0; i < votes.size();)
+      {
+        std::size_t j = i;
+        while (j < votes.size() && votes[j] == votes[i])
+          ++j;
+        if (j - i > most)
         {
-          most  = n;
-          piece = p;
+          most  = static_cast<unsigned int>(j - i);
+          piece = votes[i];
         }
+        i = j;
+      }
       // A particle of that piece at the same rest position: the vertex itself, or one
       // of its copies if it lies on a cut: the one whose tetrahedra contain the points
       // just inside w's own tetrahedra (a copy's tetrahedra lie on its side), the

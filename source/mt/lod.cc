@@ -414,7 +414,7 @@ namespace lacerta::mt
       }
     };
     std::uint32_t     j         = mt->vertex_node[v];
-    const std::size_t first_cut = mt->vertices.size() - mt->cut_origin.size();
+    const std::size_t first_cut = mt->first_cut_vertex();
     if (v >= first_cut)
     {
       // A vertex a cut created: it can come in with any node whose fragments contain

@@ -39,6 +39,18 @@ namespace lacerta::physics
         << ", " << x[3 * i + 2] << ")";
       return s.str();
     }
+
+
+    /// Energies far below a spring stretched to twice its length are noise.
+    double
+    noise_energy(const ParticleSystem &system)
+    {
+      double spring_energy = 0;
+      for (std::size_t s = 0; s < system.springs.size(); ++s)
+        spring_energy += system.springs.stiffness[s] * system.springs.rest_length[s]
+                         * system.springs.rest_length[s];
+      return 1e-12 * spring_energy;
+    }
   } // namespace
 
 
@@ -130,19 +142,21 @@ namespace lacerta::physics
 
   BlowUpMonitor::BlowUpMonitor(const ParticleSystem &system, const double tolerance)
       : tolerance(tolerance)
-      , initial_energy(system.kinetic_energy() + system.elastic_energy()
-                       + system.body_force_energy())
       , energy_scale(system.kinetic_energy() + system.elastic_energy())
-      , previous_position(system.position)
-      , previous_load(system.position.size(), 0.0)
-      , load(system.position.size(), 0.0)
+      , energy_floor(noise_energy(system))
   {
-    // Energies far below a spring stretched to twice its length are noise.
-    double spring_energy = 0;
-    for (std::size_t s = 0; s < system.springs.size(); ++s)
-      spring_energy += system.springs.stiffness[s] * system.springs.rest_length[s]
-                       * system.springs.rest_length[s];
-    energy_floor = 1e-12 * spring_energy;
+    start_ledger(system);
+  }
+
+
+  void
+  BlowUpMonitor::start_ledger(const ParticleSystem &system)
+  {
+    initial_energy =
+      system.kinetic_energy() + system.elastic_energy() + system.body_force_energy();
+    work              = 0;
+    previous_position = system.position;
+    load.assign(system.position.size(), 0.0);
     compute_load_forces(system);
     previous_load = load;
   }
@@ -187,15 +201,17 @@ namespace lacerta::physics
   }
 
 
-  void
+  double
   BlowUpMonitor::check_energy(const ParticleSystem &system,
                               const unsigned int    step,
                               const double          time,
                               const std::string    &after) const
   {
-    const double energy =
-      system.kinetic_energy() + system.elastic_energy() + system.body_force_energy();
-    const double excess = energy - initial_energy - work;
+    const double kinetic = system.kinetic_energy();
+    const double elastic = system.elastic_energy();
+    const double body    = system.body_force_energy();
+    const double energy  = kinetic + elastic + body;
+    const double excess  = energy - initial_energy - work;
     // The scale: the largest energy of the states already accepted, or the energy the
     // system may have now, not the energy under test.
     const double scale =
@@ -233,6 +249,7 @@ namespace lacerta::physics
                   speed,
                   " m/s. Reduce 'Time step' or add damping.");
     }
+    return kinetic + elastic + std::abs(body);
   }
 
 
@@ -253,12 +270,8 @@ namespace lacerta::physics
     // The scale is the largest energy of the states already accepted: had it included
     // the state under test, the excess could never exceed it with a tolerance of 1
     // (the default), and a run reached 1e127 J unstopped.
-    check_energy(system, step, time, "");
-    const double kinetic = system.kinetic_energy();
-    const double elastic = system.elastic_energy();
-    const double body    = system.body_force_energy();
     energy_scale =
-      std::max(energy_scale, kinetic + elastic + std::abs(body) + std::abs(work));
+      std::max(energy_scale, check_energy(system, step, time, "") + std::abs(work));
   }
 
 
@@ -270,27 +283,12 @@ namespace lacerta::physics
   {
     const std::string after = " (right after " + cause + ")";
     check_finite(system, step, time, after);
-    const double energy =
-      system.kinetic_energy() + system.elastic_energy() + system.body_force_energy();
-    double spring_energy = 0;
-    for (std::size_t s = 0; s < system.springs.size(); ++s)
-      spring_energy += system.springs.stiffness[s] * system.springs.rest_length[s]
-                       * system.springs.rest_length[s];
-    energy_floor = std::max(energy_floor, 1e-12 * spring_energy);
-    check_energy(system, step, time, after);
-    energy_scale = std::max(energy_scale,
-                            system.kinetic_energy() + system.elastic_energy()
-                              + std::abs(system.body_force_energy()));
+    energy_floor = std::max(energy_floor, noise_energy(system));
+    energy_scale = std::max(energy_scale, check_energy(system, step, time, after));
     // The ledger starts again from the new state: the work of the loads since the
     // last check is lost with the old particles, and carrying an excess over many
     // changes (a stroke changes the system at every step) accumulated that loss into
     // false alarms.
-    initial_energy    = energy;
-    work              = 0;
-    previous_position = system.position;
-    previous_load.assign(system.position.size(), 0.0);
-    load.assign(system.position.size(), 0.0);
-    compute_load_forces(system);
-    previous_load = load;
+    start_ledger(system);
   }
 } // namespace lacerta::physics

@@ -135,11 +135,10 @@ namespace lacerta::scene
     restart_cutter();
     if (lacerator)
     {
-      // Particles the MT's cuts created (the last cut_origin.size() vertex ids): among
-      // them the lacerator finds those of its tears again.
-      const mt::MultiTriangulation     &mt    = multiresolution->multi_triangulation();
-      const std::size_t                 first = mt.vertices.size() - mt.cut_origin.size();
-      const std::vector<std::uint32_t> &ids   = multiresolution->active_vertices();
+      // Particles the MT's cuts created: among them the lacerator finds those of its
+      // tears again.
+      const std::size_t first = multiresolution->multi_triangulation().first_cut_vertex();
+      const std::vector<std::uint32_t> &ids = multiresolution->active_vertices();
       std::vector<std::uint8_t>         created(ids.size());
       for (std::size_t i = 0; i < ids.size(); ++i)
         created[i] = ids[i] >= first;

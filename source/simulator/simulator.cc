@@ -283,12 +283,12 @@ namespace lacerta
 
 
   unsigned int
-  Simulator::choose_substeps()
+  Simulator::choose_substeps(const unsigned int current)
   {
     const physics::ParticleSystem &system = *scene->system;
     const physics::FrequencyBound  bound  = physics::bound_highest_frequency(system);
     if (bound.omega == 0)
-      return 1;
+      return current > 0 ? current : 1;
     if (!std::isfinite(bound.omega))
       throw_error("The simulation blew up: the bound on the highest eigenfrequency is "
                   "not finite at ",
@@ -297,6 +297,8 @@ namespace lacerta
     const double critical = integrator->critical_time_step(bound.omega,
                                                            system.mass_damping,
                                                            system.spring_damping);
+    if (current > 0 && time_step / current <= safety_factor * critical)
+      return current;
     std::cout << "Stability: highest eigenfrequency <= " << bound.omega
               << " rad/s (Gershgorin bound at particle " << bound.particle
               << "); critical time step " << critical << " s; time step " << time_step
@@ -340,20 +342,6 @@ namespace lacerta
     std::cout << "Stability: each step is split into " << n << " sub-steps of "
               << time_step / n << " s\n";
     return n;
-  }
-
-
-  bool
-  Simulator::needs_more_substeps(const unsigned int substeps) const
-  {
-    const physics::ParticleSystem &system = *scene->system;
-    const physics::FrequencyBound  bound  = physics::bound_highest_frequency(system);
-    if (bound.omega == 0)
-      return false;
-    const double critical = integrator->critical_time_step(bound.omega,
-                                                           system.mass_damping,
-                                                           system.spring_damping);
-    return !(time_step / substeps <= safety_factor * critical);
   }
 
 
@@ -404,12 +392,10 @@ namespace lacerta
     state.substeps = substeps;
 
     // After a topology change or a new level of detail the particles and springs are
-    // others: the integrator's scratch space, the stability limit and the energy
-    // baseline of the blow-up monitor start afresh (the invariants are checked first
-    // if @p check_now).
-    // The monitor carries its energy ledger over the change and checks the new state
-    // at once: a change at every step must not hide a blow-up, and a change that puts
-    // particles far off must stop the run naming it (@p cause).
+    // others: the integrator's scratch space and the stability limit start afresh (the
+    // invariants are checked first if @p check_now). The blow-up monitor checks the new
+    // state against its ledger at once, so that a change that puts particles far off
+    // stops the run naming it (@p cause), then restarts its ledger.
     const auto system_changed = [&](const unsigned int step,
                                     const double       at,
                                     const bool         check_now,
@@ -443,8 +429,8 @@ namespace lacerta
         // The limit falls when an element collapses (the geometric stiffness of a
         // strongly compressed spring) without any change of the system: keeping the
         // sub-steps chosen at the last change let the severed kidney pole blow up.
-        if (substep_when_unstable && needs_more_substeps(substeps))
-          substeps = state.substeps = choose_substeps();
+        if (substep_when_unstable)
+          substeps = state.substeps = choose_substeps(substeps);
       }
       if (needs_energies)
       {

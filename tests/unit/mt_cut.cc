@@ -310,7 +310,7 @@ namespace lacerta
   TEST(MtCut, VerticesACutCreatedAreLocatedInThePreviousLevel)
   {
     LodCut            c(*uniform(0.5), {vertical(-0.2, 0.43), vertical(1.2, 0.47)}, 12);
-    const std::size_t first = c.mt.n_vertices() - c.mt.cut_origin.size();
+    const std::size_t first = c.mt.first_cut_vertex();
     ASSERT_GT(c.mt.cut_origin.size(), 0u);
     // Coarse to fine and back: every vertex brought in by either extraction, cut
     // vertices included, lies in a tet that was active before.

@@ -112,6 +112,13 @@ namespace lacerta::mt
       return static_cast<unsigned int>(vertices.size());
     }
 
+    /// The id of the first vertex a cut created: ids from here on have a cut_origin.
+    std::size_t
+    first_cut_vertex() const
+    {
+      return vertices.size() - cut_origin.size();
+    }
+
     /// Number of tetrahedra node @p j inserts.
     unsigned int
     n_fine(const unsigned int j) const

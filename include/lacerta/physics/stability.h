@@ -98,12 +98,17 @@ namespace lacerta::physics
                  double                time,
                  const std::string    &after) const;
 
-    /// Throws if the energy exceeds the ledger by more than the tolerance.
-    void
+    /// Throws if the energy exceeds the ledger by more than the tolerance; returns the
+    /// state's energy scale (kinetic + elastic + |body force potential|).
+    double
     check_energy(const ParticleSystem &system,
                  unsigned int          step,
                  double                time,
                  const std::string    &after) const;
+
+    /// Starts the energy ledger (initial energy, work, loads) from the current state.
+    void
+    start_ledger(const ParticleSystem &system);
 
     double              tolerance;
     double              initial_energy;

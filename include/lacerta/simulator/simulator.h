@@ -74,14 +74,13 @@ namespace lacerta
     }
 
   private:
-    /// Checks the time step against the stability limit; returns the sub-step count.
+    /**
+     * Checks the time step against the stability limit of the current state; returns
+     * the sub-step count. @p current sub-steps, if given and still below the limit,
+     * are kept without a report.
+     */
     unsigned int
-    choose_substeps();
-
-    /// Whether @p substeps sub-steps per step are no longer below the stability limit
-    /// of the current state.
-    bool
-    needs_more_substeps(unsigned int substeps) const;
+    choose_substeps(unsigned int current = 0);
 
     std::string  output_directory;
     double       end_time;
