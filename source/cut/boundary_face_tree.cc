@@ -1,6 +1,7 @@
 #include <lacerta/cut/boundary_face_tree.h>
 
 #include <algorithm>
+#include <cmath>
 
 namespace lacerta::cut
 {
@@ -60,21 +61,52 @@ namespace lacerta::cut
     nodes.clear();
     for (const auto &bf : mesh.get_boundary_faces())
       faces.push_back(make_face(mesh, bf.tet, bf.face));
+    // The vertices of the faces: the boundary vertices, in order.
+    vertices.clear();
+    for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
+      if (mesh.is_boundary_vertex(v))
+        vertices.push_back(v);
+    fitted.resize(3 * vertices.size());
+    inflation = 0;
     if (!faces.empty())
-      build_node(0, static_cast<unsigned int>(faces.size()), x);
+    {
+      // The faces with their boxes and centroids (sums of the three vertices), read
+      // from the positions once instead of at every level of the tree.
+      work.resize(faces.size());
+      sizes.resize(faces.size());
+      for (std::size_t i = 0; i < faces.size(); ++i)
+      {
+        const Face &f = faces[i];
+        work[i].face  = f;
+        work[i].box   = face_box(f, x);
+        for (unsigned int d = 0; d < 3; ++d)
+          work[i].centre[d] = x[3 * f.vertices[0] + d] + x[3 * f.vertices[1] + d]
+                              + x[3 * f.vertices[2] + d];
+        const Box &b = work[i].box;
+        sizes[i]     = std::max(
+          {b.upper[0] - b.lower[0], b.upper[1] - b.lower[1], b.upper[2] - b.lower[2]});
+      }
+      // The margin: a quarter of the median face size, so that a vertex crosses it
+      // in many time steps (a stable step moves it by a small part of an edge) while
+      // a query gets few extra candidates from the inflated boxes.
+      std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
+      inflation = 0.25 * sizes[sizes.size() / 2];
+      build_node(0, static_cast<unsigned int>(faces.size()));
+      for (std::size_t i = 0; i < faces.size(); ++i)
+        faces[i] = work[i].face;
+    }
+    fit(x);
   }
 
 
   unsigned int
-  BoundaryFaceTree::build_node(const unsigned int first,
-                               const unsigned int count,
-                               const double      *x)
+  BoundaryFaceTree::build_node(const unsigned int first, const unsigned int count)
   {
     const unsigned int index = static_cast<unsigned int>(nodes.size());
     nodes.push_back({});
     Box box;
     for (unsigned int i = first; i < first + count; ++i)
-      box.extend(face_box(faces[i], x));
+      box.extend(work[i].box);
     if (count <= 4)
     {
       nodes[index] = {box, first, count, 0, 0};
@@ -85,45 +117,71 @@ namespace lacerta::cut
     for (unsigned int d = 1; d < 3; ++d)
       if (box.upper[d] - box.lower[d] > box.upper[axis] - box.lower[axis])
         axis = d;
-    const auto centre = [&](const Face &f)
-    {
-      return x[3 * f.vertices[0] + axis] + x[3 * f.vertices[1] + axis]
-             + x[3 * f.vertices[2] + axis];
-    };
     const unsigned int half = count / 2;
-    std::nth_element(faces.begin() + first,
-                     faces.begin() + first + half,
-                     faces.begin() + first + count,
-                     [&](const Face &a, const Face &b) { return centre(a) < centre(b); });
-    const unsigned int left  = build_node(first, half, x);
-    const unsigned int right = build_node(first + half, count - half, x);
+    std::nth_element(work.begin() + first,
+                     work.begin() + first + half,
+                     work.begin() + first + count,
+                     [&](const Entry &a, const Entry &b)
+                     { return a.centre[axis] < b.centre[axis]; });
+    const unsigned int left  = build_node(first, half);
+    const unsigned int right = build_node(first + half, count - half);
     nodes[index]             = {box, first, 0, left, right};
     return index;
   }
 
 
-  void
+  bool
   BoundaryFaceTree::refit(const mesh::TetMesh &mesh, const double *x)
   {
     if (extra.size() > 64 + faces.size() / 10)
     {
       build(mesh, x);
-      return;
+      return true;
     }
+    // The boxes hold while every vertex is within the margin of where it was fitted
+    // (written so that a NaN position refits too).
+    for (std::size_t k = 0; k < vertices.size(); ++k)
+    {
+      const double *p = x + 3 * std::size_t(vertices[k]);
+      const double *q = fitted.data() + 3 * k;
+      if (!(std::abs(p[0] - q[0]) <= inflation && std::abs(p[1] - q[1]) <= inflation
+            && std::abs(p[2] - q[2]) <= inflation))
+      {
+        fit(x);
+        return true;
+      }
+    }
+    return false;
+  }
+
+
+  void
+  BoundaryFaceTree::fit(const double *x)
+  {
     // Children always come after their parent: one backward sweep refits the tree.
     for (std::size_t i = nodes.size(); i-- > 0;)
     {
       Node &n = nodes[i];
       n.box   = Box();
       if (n.count > 0)
+      {
         for (unsigned int k = n.first; k < n.first + n.count; ++k)
           n.box.extend(face_box(faces[k], x));
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          n.box.lower[d] -= inflation;
+          n.box.upper[d] += inflation;
+        }
+      }
       else
       {
         n.box.extend(nodes[n.left].box);
         n.box.extend(nodes[n.right].box);
       }
     }
+    for (std::size_t k = 0; k < vertices.size(); ++k)
+      for (unsigned int d = 0; d < 3; ++d)
+        fitted[3 * k + d] = x[3 * std::size_t(vertices[k]) + d];
   }
 
 

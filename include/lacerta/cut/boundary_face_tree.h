@@ -13,12 +13,15 @@
 namespace lacerta::cut
 {
   /**
-   * Axis-aligned boxes over the boundary faces, built once by median splits and
-   * refitted bottom-up as the tissue deforms (the topology of the tree does not change
-   * with the positions). Faces a cut creates are kept in a short list that is searched
-   * linearly and folded into a rebuild once it is a tenth of the tree, so that the
-   * cost of a cut stays proportional to the faces it creates. Faces that stopped being
-   * boundary are skipped at query time.
+   * Axis-aligned boxes over the boundary faces, built once by median splits. The boxes
+   * are inflated by a margin (a quarter of the median face size at the build), so
+   * that they stay valid while no vertex of the tree has moved farther than the
+   * margin (in any coordinate) from where it was at the last fit; only then are they
+   * refitted bottom-up (the topology of the tree does not change with the positions).
+   * Faces a cut creates are kept in a short list that is searched linearly and
+   * folded into a rebuild once it is a tenth of the tree, so that the cost of a cut
+   * stays proportional to the faces it creates. Faces that stopped being boundary
+   * are skipped at query time.
    */
   class BoundaryFaceTree
   {
@@ -37,11 +40,21 @@ namespace lacerta::cut
     build(const mesh::TetMesh &mesh, const double *x);
 
     /**
-     * Recomputes every box for the positions @p x (O(number of faces), no allocation),
-     * or rebuilds the tree if the faces added since the last build are many.
+     * Makes the boxes valid for the positions @p x: recomputes them (O(number of
+     * faces), no allocation) if a vertex of the tree has moved beyond the margin since
+     * the last fit, or rebuilds the tree if the faces added since the last build are
+     * many. Otherwise it only compares the positions with those of the last fit.
+     * Returns whether the boxes were recomputed.
      */
-    void
+    bool
     refit(const mesh::TetMesh &mesh, const double *x);
+
+    /// How far (in every coordinate) a vertex may move before the boxes are refitted.
+    double
+    margin() const
+    {
+      return inflation;
+    }
 
     /// Records boundary face (tet, face) of @p mesh, created by a cut.
     void
@@ -78,14 +91,35 @@ namespace lacerta::cut
       unsigned int left, right;
     };
 
+    /// A face while the tree is built: its box and its centroid (times 3).
+    struct Entry
+    {
+      Face                  face;
+      Box                   box;
+      std::array<double, 3> centre;
+    };
+
+    /// Builds the node over `work` [first, first + count) and its subtree.
     unsigned int
-    build_node(unsigned int first, unsigned int count, const double *x);
+    build_node(unsigned int first, unsigned int count);
 
     static Box
     face_box(const Face &f, const double *x);
 
-    std::vector<Face> faces;
-    std::vector<Face> extra;
-    std::vector<Node> nodes;
+    /// Recomputes every box for @p x, inflated by the margin, and records @p x as the
+    /// positions of the fit.
+    void
+    fit(const double *x);
+
+    std::vector<Face>   faces;
+    std::vector<Entry>  work;
+    std::vector<double> sizes;
+    std::vector<Face>   extra;
+    std::vector<Node>   nodes;
+    /// The vertices of `faces`, once each, and their positions at the last fit (3 per
+    /// vertex, in the same order).
+    std::vector<unsigned int> vertices;
+    std::vector<double>       fitted;
+    double                    inflation = 0;
   };
 } // namespace lacerta::cut
