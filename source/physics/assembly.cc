@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <optional>
+#include <typeinfo>
 
 namespace lacerta::physics
 {
@@ -76,6 +78,39 @@ namespace lacerta::physics
                                   m[i] += sigma * rule.coordinates[q][i] * jxw;
                               });
     return m;
+  }
+
+
+  std::array<double, 4>
+  tet_mass_contributions(const mesh::TetMesh &mesh,
+                         const unsigned int   t,
+                         const double         sigma)
+  {
+    // The same sums in the same order as above with σ(x) = sigma, so that the
+    // contributions are bit-identical; only the quadrature points and the calls of
+    // the density are saved.
+    static const BarycentricRule rule;
+    std::array<double, 4>        m      = {{0, 0, 0, 0}};
+    const double                 volume = mesh.volume(t);
+    for (unsigned int q = 0; q < rule.weights.size(); ++q)
+    {
+      const double jxw = rule.weights[q] * volume;
+      for (unsigned int i = 0; i < 4; ++i)
+        m[i] += sigma * rule.coordinates[q][i] * jxw;
+    }
+    return m;
+  }
+
+
+  std::optional<double>
+  constant_value(const dealii::Function<3, double> &f)
+  {
+    // The exact types only: a class derived from them may override value().
+    if (f.n_components != 1
+        || (typeid(f) != typeid(dealii::Functions::ConstantFunction<3, double>)
+            && typeid(f) != typeid(dealii::Functions::ZeroFunction<3, double>)))
+      return std::nullopt;
+    return f.value(dealii::Point<3>());
   }
 
 

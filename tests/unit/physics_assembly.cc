@@ -42,6 +42,33 @@ TEST(Assembly, EachTetrahedronGivesItsVerticesItsOwnMass)
 }
 
 
+TEST(Assembly, ConstantDensityShortcutGivesTheSameMassesToTheLastBit)
+{
+  // The cutter's shortcut for a constant density must not change any mass: the same
+  // quadrature sums, bit for bit, on every cell of a distorted mesh.
+  const mesh::TetMesh mesh =
+    test_support::distorted_box(3, 0.25, dealii::Point<3>(1.0, 2.0, 0.5));
+  const dealii::Functions::ConstantFunction<3> density(1234.5);
+  const auto                                   sigma = physics::constant_value(density);
+  ASSERT_TRUE(sigma.has_value());
+  EXPECT_EQ(*sigma, 1234.5);
+  for (unsigned int t = 0; t < mesh.n_tets(); ++t)
+  {
+    const auto by_function = physics::tet_mass_contributions(mesh, t, density);
+    const auto by_value    = physics::tet_mass_contributions(mesh, t, *sigma);
+    for (unsigned int i = 0; i < 4; ++i)
+      EXPECT_EQ(by_function[i], by_value[i]) << "tet " << t << " vertex " << i;
+  }
+  EXPECT_EQ(physics::constant_value(dealii::Functions::ZeroFunction<3>()), 0.0);
+  // Functions that are not known to be constant are evaluated point by point.
+  dealii::FunctionParser<3> parsed(1);
+  parsed.initialize("x,y,z", "1000", {});
+  EXPECT_FALSE(physics::constant_value(parsed).has_value());
+  EXPECT_FALSE(
+    physics::constant_value(dealii::Functions::ConstantFunction<3>(1.0, 2)).has_value());
+}
+
+
 TEST(Assembly, StiffnessOfOneTetrahedronByHand)
 {
   // Unit corner tetrahedron, E = 2: V = 1/6; edges of length 1 get 2 * (1/6) / 1 = 1/3,

@@ -17,6 +17,7 @@
 #include <array>
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace dealii
@@ -298,8 +299,10 @@ namespace lacerta::cut
     const dealii::Function<3, double> &density;
     const dealii::Function<3, double> &youngs_modulus;
     double                            &integral_of_density;
-    Parameters                         parameters;
-    Blade                              current;
+    /// The density's value if it is constant (physics::constant_value()).
+    std::optional<double> constant_density;
+    Parameters            parameters;
+    Blade                 current;
     /// The crack front as last applied: the start of the next swept surface.
     Blade front;
     /// Where the blade was at the end of the last sweep tried: a corner of the path

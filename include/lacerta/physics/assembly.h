@@ -8,6 +8,7 @@
 #include <lacerta/physics/spring_set.h>
 
 #include <array>
+#include <optional>
 #include <vector>
 
 namespace dealii
@@ -49,6 +50,21 @@ namespace lacerta::physics
   tet_mass_contributions(const mesh::TetMesh               &mesh,
                          unsigned int                       t,
                          const dealii::Function<3, double> &density);
+
+  /**
+   * tet_mass_contributions() for a density that is @p sigma everywhere: the same
+   * values to the last bit, without evaluating a Function at the quadrature points.
+   */
+  std::array<double, 4>
+  tet_mass_contributions(const mesh::TetMesh &mesh, unsigned int t, double sigma);
+
+  /**
+   * The value of @p f if it is a scalar dealii::Functions::ConstantFunction or
+   * ZeroFunction (so that callers can use the constant-density overload), otherwise
+   * nothing.
+   */
+  std::optional<double>
+  constant_value(const dealii::Function<3, double> &f);
 
   /**
    * The contribution E(centroid) V(τ) of tetrahedron @p t to the numerator of every
