@@ -107,6 +107,7 @@ namespace lacerta::cut
     system.springs.reserve(room(system.springs.size()));
     vertex_scratch.reserve(room(mesh.n_vertices()));
     on_surface.reserve(room(mesh.n_vertices()));
+    joined_at.reserve(room(mesh.n_vertices()));
     swept.reserve(room(mesh.n_vertices()));
     edge_scratch.reserve(room(mesh.n_edges()));
     edge_stamp.reserve(room(mesh.n_edges()));
@@ -149,6 +150,8 @@ namespace lacerta::cut
     ++stroke;
     stroke_has_cut = false;
     after_corner   = false;
+    corner_pending = false;
+    anchors.clear();
   }
 
 
@@ -332,21 +335,70 @@ namespace lacerta::cut
     // (and, crossing the crack's cells diagonally, often nothing at all, leaving the
     // corner uncut): the front is first brought to the corner, without waiting, so
     // that the next side starts from the corner line.
+    measure_front_drift();
+    const Point front_before = front.tail;
+    // A catch-up that was postponed is retried towards the same corner: towards where
+    // the blade was at the next sweep instead, the front would cut a chord across it.
     const auto  mid = [](const Blade &b) { return scale(0.5, add(b.tail, b.head)); };
     const Point a = sub(mid(last_end), mid(front)), b = sub(mid(end), mid(last_end));
-    if (norm(a) > 1e-12 * typical_edge && norm(b) > 0
+    if (!corner_pending && norm(a) > 1e-12 * typical_edge && norm(b) > 0
         && dot(a, b) < std::cos(corner_angle) * norm(a) * norm(b))
     {
-      catching_up = true;
-      sweep_once(last_end, statistics);
+      corner         = last_end;
+      corner_pending = true;
+      catching_up    = true;
+      sweep_once(corner, statistics);
       catching_up  = false;
-      after_corner = after_corner || front.tail == last_end.tail;
+      after_corner = after_corner || front.tail == corner.tail;
+      if (front.tail == corner.tail)
+        corner_pending = false;
+    }
+    else if (corner_pending)
+    {
+      catching_up = true;
+      sweep_once(corner, statistics);
+      catching_up = false;
+      if (front.tail == corner.tail)
+      {
+        corner_pending = false;
+        after_corner   = true;
+      }
     }
     sweep_once(end, statistics);
+    // The front's tissue: the cells the blade is in where the front was applied.
+    if (!(front.tail == front_before))
+      anchor_front();
     // The first sweep of the new side that advances the front ends the corner.
     if (front.tail == end.tail)
       after_corner = false;
     last_end = end;
+  }
+
+
+  void
+  Cutter::anchor_front()
+  {
+    anchors.clear();
+    for (const unsigned int t : active)
+      for (const unsigned int v : mesh.tet(t))
+        anchors.push_back(v);
+    std::sort(anchors.begin(), anchors.end());
+    anchors.erase(std::unique(anchors.begin(), anchors.end()), anchors.end());
+    anchored_at.resize(anchors.size());
+    for (std::size_t i = 0; i < anchors.size(); ++i)
+      anchored_at[i] = position(anchors[i]);
+  }
+
+
+  void
+  Cutter::measure_front_drift()
+  {
+    front_drift = Point{{0, 0, 0}};
+    if (anchors.empty())
+      return;
+    for (std::size_t i = 0; i < anchors.size(); ++i)
+      front_drift = add(front_drift, sub(position(anchors[i]), anchored_at[i]));
+    front_drift = scale(1.0 / anchors.size(), front_drift);
   }
 
 
@@ -395,6 +447,18 @@ namespace lacerta::cut
       surface.start_dir = scale(-1, surface.start_dir);
     const double eps = parameters.snap_fraction;
     start_reach      = (stroke_has_cut ? start_tolerance : 1.0) * typical_edge;
+    // The front was applied where the blade was then; the tissue has moved since,
+    // and the crack's tip with it. Where the tip fell back (against the motion), the
+    // plane reaches back by as much, or the strip between the tip and the start line
+    // would stay uncut and bridge the sides. Not at a corner, where the part behind
+    // the start line belongs to the other side.
+    if (stroke_has_cut && !catching_up && !after_corner)
+    {
+      const double back = -dot(surface.start_dir, front_drift);
+      if (back > 0)
+        start_reach =
+          std::max(start_reach, std::min(back + eps * typical_edge, typical_edge));
+    }
 
     const auto t_start = Clock::now();
     lap_start          = t_start;
@@ -461,7 +525,9 @@ namespace lacerta::cut
     lap(statistics.analysis_seconds);
     if (removed.empty())
     {
-      front = end;
+      // Nothing to split: the front stays where the crack is (see below).
+      if (!stroke_has_cut)
+        front = end;
       spent();
       return;
     }
@@ -521,7 +587,12 @@ namespace lacerta::cut
           joins |= vertex_scratch[v].star_stamp == star_stamp;
         if (!joins)
         {
-          front = end;
+          // Once the stroke has cut, the front stays where the crack is: a blade that
+          // crosses an opened crack (a gap) or cuts inside one cell must not carry the
+          // front past tissue it has not cut, since a sweep does not cut behind its
+          // start line.
+          if (!stroke_has_cut)
+            front = end;
           spent();
           return;
         }
@@ -584,14 +655,20 @@ namespace lacerta::cut
     if (std::abs(d) <= 1e-12 * typical_edge)
       d = 0;
     s.d = d;
-    s.on_plane =
-      d == 0 || (on_surface[v] && std::abs(d) <= parameters.snap_fraction * typical_edge);
+    // A vertex of the stroke's crack was put on the cut surface where the blade was
+    // then; the crack opens behind the front (the sides move apart across the plane
+    // as the stretched tissue relaxes, by several millimetres in square_hole), so
+    // where it is now says little about whether a plane that continues the cut holds
+    // it. Whether it is on the plane, and reached, is judged where it joined the crack.
+    const double tolerance = parameters.snap_fraction * typical_edge;
+    const Point  at        = on_surface[v] ? joined_at[v] : x;
+    s.on_plane = d == 0 || (on_surface[v] && std::abs(surface.distance(at)) <= tolerance);
     // Reached: a vertex of the crack when behind the new front; a fresh one when also
     // not behind the start of this sweep by more than a cell (the plane must not
     // reach back along an older part of the crack), or when an earlier sweep of the
     // stroke swept it.
     s.reached = on_surface[v]
-                  ? surface.behind(x) < 0
+                  ? surface.behind(at) < 0
                   : (surface.behind(x) < 0 && surface.ahead_of_start(x) >= -start_reach)
                       || swept[v] == stroke;
     s.parent  = v;
@@ -1249,6 +1326,8 @@ namespace lacerta::cut
     on_surface.resize(mesh.n_vertices(), 0);
     if (!on_surface[v])
     {
+      joined_at.resize(mesh.n_vertices());
+      joined_at[v]  = position(v);
       on_surface[v] = 1;
       on_surface_list.push_back(v);
     }

@@ -312,6 +312,23 @@ namespace lacerta::cut
     /// front has not advanced since it reached one: children of these sweeps may be
     /// thin (the crack bends inside a cell; see has_flat_child()).
     bool catching_up = false, after_corner = false;
+    /// The corner the front is being brought to, while that has not succeeded yet.
+    Blade corner;
+    bool  corner_pending = false;
+    /// Vertices around the crack front when it was applied, and where they were then:
+    /// the crack tip moves with the tissue, the stored front does not.
+    std::vector<unsigned int> anchors;
+    std::vector<Point>        anchored_at;
+    /// The mean motion of the anchors since the front was applied.
+    Point front_drift{{0, 0, 0}};
+
+    /// Takes the vertices of the active cells as the front's anchors.
+    void
+    anchor_front();
+
+    /// Sets `front_drift` from the anchors.
+    void
+    measure_front_drift();
     /// Typical edge length at rest (median), for the sub-division when nothing is active.
     double typical_edge = 0;
     /// The current stroke (from entering the tissue to leaving it), from 1, and
@@ -326,8 +343,10 @@ namespace lacerta::cut
     std::vector<unsigned int> tet_stamp, edge_stamp;
     unsigned int              stamp = 0;
     /// Vertices on the cut surface of the current stroke (progressive cuts).
-    std::vector<std::uint8_t>           on_surface;
-    std::vector<unsigned int>           on_surface_list;
+    std::vector<std::uint8_t> on_surface;
+    std::vector<unsigned int> on_surface_list;
+    /// Where each vertex of the stroke's crack was (world) when it joined the crack.
+    std::vector<Point>                  joined_at;
     std::vector<BoundaryFaceTree::Face> hits;
     /// Stroke in which a vertex on the plane was swept by the blade (its patch opens
     /// when all of it is swept).
