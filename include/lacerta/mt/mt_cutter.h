@@ -31,11 +31,12 @@ namespace lacerta::mt
    * tetrahedron shared by two fragments, and faces shared by neighbours at any level
    * of detail, split alike. Only complete cuts separate: where the soup ends inside a
    * tetrahedron (a crack front) the crack closes along its cut edges; the surface near
-   * those tetrahedra is kept and cut again with later records that reach them, so that
-   * a crack continued from its front opens there too. Cut points are merged by edge and
-   * side; a vertex on the cut gets one copy per group of children around it connected
-   * through faces not on the cut, over all levels at once, as the cutter does within one
-   * mesh.
+   * those tetrahedra is kept and cut again with later records whose surface meets it,
+   * so that a crack continued from its front opens there too. Cut points are merged by
+   * edge and side; a vertex on the cut gets one copy per group of children around it
+   * connected through faces not on the cut (tetrahedra around it that the table leaves
+   * whole keep it and connect the groups), over all levels at once, as the cutter does
+   * within one mesh.
    *
    * Children keep the creator and destroyer of the tet they replace: the node's
    * fragments list them instead of the parent (MultiTriangulation::cut_fine,
