@@ -530,24 +530,20 @@ namespace lacerta::mt
     }
     if (!closed_tets.empty())
     {
-      std::vector<std::uint8_t> keep(surface.size(), 0);
+      // The triangles in the grid cells those tetrahedra's boxes meet, each once.
+      ++triangle_stamp;
       for (const cut::Box &box : closed_tets)
-      {
-        near_triangles(box, near);
-        for (const std::uint32_t k : near)
-        {
-          cut::Box triangle_box;
-          for (const Point &p : surface[k])
-            triangle_box.extend(p);
-          keep[k] |= triangle_box.overlaps(box);
-        }
-      }
-      for (std::size_t k = 0; k < surface.size(); ++k)
-        if (keep[k])
-        {
-          kept_surface.push_back(surface[k]);
-          kept_normal.push_back(normal[k]);
-        }
+        for_each_cell(box,
+                      [&](const std::size_t k)
+                      {
+                        for (const std::uint32_t t : surface_cells[k])
+                          if (triangle_seen[t] != triangle_stamp)
+                          {
+                            triangle_seen[t] = triangle_stamp;
+                            kept_surface.push_back(surface[t]);
+                            kept_normal.push_back(normal[t]);
+                          }
+                      });
     }
 
     // 4. The children, with the cut points merged by edge and side, and the vertices
@@ -611,9 +607,15 @@ namespace lacerta::mt
     // nearby) keep the vertex and connect the children around them: left out, two
     // groups joined only through them got different vertices, and the faces between
     // them opened off the surface (a flap at the old tip of a continued tear).
-    std::set<std::uint32_t> split_tets;
+    // The split tetrahedra are marked in `seen` with a stamp of their own.
+    seen.resize(mt.n_tets(), 0);
+    if (++stamp == 0)
+    {
+      std::fill(seen.begin(), seen.end(), 0);
+      stamp = 1;
+    }
     for (const Split &s : splits)
-      split_tets.insert(s.tet);
+      seen[s.tet] = stamp;
     for (const auto &[v, list] : incident)
     {
       std::vector<mesh::Tet>    members;
@@ -624,7 +626,7 @@ namespace lacerta::mt
         member_cut_faces.push_back(child_cut_faces[c]);
       }
       for (const std::uint32_t t : vertex_tets[v])
-        if (mt.is_live(t) && !split_tets.count(t))
+        if (seen[t] != stamp && mt.is_live(t))
         {
           members.push_back(mt.tets[t]);
           member_cut_faces.push_back(0);
