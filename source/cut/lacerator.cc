@@ -7,6 +7,7 @@
 #include <deal.II/base/point.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -143,7 +144,8 @@ namespace lacerta::cut
   void
   Lacerator::collect_surface_springs()
   {
-    std::vector<std::pair<unsigned int, unsigned int>> edges;
+    // (a, b, a tetrahedron with the edge on a boundary face), a < b.
+    std::vector<std::array<unsigned int, 3>> edges;
     edges.reserve(3 * mesh.get_boundary_faces().size());
     for (const auto &f : mesh.get_boundary_faces())
     {
@@ -152,17 +154,22 @@ namespace lacerta::cut
       {
         const unsigned int a = mesh.tet(f.tet)[fv[k]],
                            b = mesh.tet(f.tet)[fv[(k + 1) % 3]];
-        edges.emplace_back(std::min(a, b), std::max(a, b));
+        edges.push_back({{std::min(a, b), std::max(a, b), f.tet}});
       }
     }
     std::sort(edges.begin(), edges.end());
-    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    edges.erase(std::unique(edges.begin(),
+                            edges.end(),
+                            [](const std::array<unsigned int, 3> &x,
+                               const std::array<unsigned int, 3> &y)
+                            { return x[0] == y[0] && x[1] == y[1]; }),
+                edges.end());
     surface.clear();
     surface.reserve(edges.size());
-    for (const auto &[a, b] : edges)
+    for (const auto &[a, b, t] : edges)
     {
       const Point &xa = mesh.vertex(a), &xb = mesh.vertex(b);
-      surface.push_back({a, b, norm(sub(xb, xa)), limit_at(midpoint(xa, xb))});
+      surface.push_back({a, b, norm(sub(xb, xa)), limit_at(midpoint(xa, xb)), t});
     }
     surface_valid = true;
   }
@@ -243,24 +250,121 @@ namespace lacerta::cut
 
 
   void
-  Lacerator::find_crossings(const Laceration &l)
+  Lacerator::find_crossings(const Laceration &l, const unsigned int seed_tet)
   {
     crossings.clear();
     const physics::SpringSet &springs = system.springs;
-    for (std::size_t s = 0; s < springs.size(); ++s)
+    AssertDimension(springs.size(), mesh.n_edges());
+    // Spring s (the mesh's edge s) crosses the plane within the blade's extent: then
+    // its crossing is appended. The same test as a scan over all springs would make.
+    const auto crossing = [&](const unsigned int s)
     {
       const Point  xa = position(springs.a[s]), xb = position(springs.b[s]);
       const double da = dot(l.normal, sub(xa, l.origin));
       const double db = dot(l.normal, sub(xb, l.origin));
       if ((da > 0) == (db > 0) || da == db)
-        continue;
+        return false;
       const Point  p      = lerp(xa, xb, da / (da - db));
       const double across = dot(l.across, sub(p, l.origin));
       if (across < l.across_lo - l.edge || across > l.across_hi + l.edge)
-        continue;
+        return false;
       crossings.push_back(
-        {p, dot(l.advance, sub(p, l.origin)), springs.a[s], springs.b[s]});
+        {p, dot(l.advance, sub(p, l.origin)), springs.a[s], springs.b[s], s});
+      return true;
+    };
+    // Whether the vertices of tetrahedron t other than local vertex `skip` (4: none)
+    // lie on both sides of the plane.
+    const auto crosses = [&](const unsigned int t, const unsigned int skip)
+    {
+      bool above = false, below = false;
+      for (unsigned int k = 0; k < 4; ++k)
+        if (k != skip)
+          (dot(l.normal, sub(position(mesh.tet(t)[k]), l.origin)) > 0 ? above : below) =
+            true;
+      return above && below;
+    };
+
+    // The section is walked from the seed's tetrahedron through the tetrahedra that
+    // cross the plane, across the faces that cross it: the cost is that of the section
+    // within the blade's extent, not of the mesh (doc/lacerations.md). If the seed's
+    // tetrahedron does not cross the plane (a continuation's seed beside it), the
+    // nearest that do are looked for up to a few face neighbours away.
+    // Stamps instead of clearing: the arrays grow with the mesh, once. The rings
+    // looked at around the seed are marked walk + 1, the tetrahedra the walk reached
+    // walk; the next walk starts past both.
+    tet_walk.resize(mesh.n_tets(), 0);
+    edge_walk.resize(mesh.n_edges(), 0);
+    edge_in_extent.resize(mesh.n_edges(), 0);
+    walk += 2;
+    if (walk < 2)
+    {
+      std::fill(tet_walk.begin(), tet_walk.end(), 0);
+      std::fill(edge_walk.begin(), edge_walk.end(), 0);
+      walk = 2;
     }
+    const unsigned int looked = walk + 1;
+    walk_queue.clear();
+    walk_ring.assign(1, seed_tet);
+    tet_walk[seed_tet] = looked;
+    for (unsigned int ring = 0; ring < 4 && walk_queue.empty() && !walk_ring.empty();
+         ++ring)
+    {
+      walk_next_ring.clear();
+      for (const unsigned int t : walk_ring)
+        if (crosses(t, 4))
+          walk_queue.push_back(t);
+        else
+          for (unsigned int f = 0; f < 4; ++f)
+          {
+            const unsigned int n = mesh.neighbor(t, f);
+            if (n != mesh::invalid_index && tet_walk[n] != looked)
+            {
+              tet_walk[n] = looked;
+              walk_next_ring.push_back(n);
+            }
+          }
+      walk_ring.swap(walk_next_ring);
+    }
+    for (const unsigned int t : walk_queue)
+      tet_walk[t] = walk;
+    if (walk_queue.empty())
+    {
+      // No tetrahedron near the seed meets the plane: every spring is tested.
+      for (unsigned int s = 0; s < springs.size(); ++s)
+        crossing(s);
+      return;
+    }
+    for (std::size_t i = 0; i < walk_queue.size(); ++i)
+    {
+      const unsigned int t      = walk_queue[i];
+      bool               inside = false;
+      for (const unsigned int e : mesh.tet_edges(t))
+      {
+        if (edge_walk[e] != walk)
+        {
+          edge_walk[e]      = walk;
+          edge_in_extent[e] = crossing(e);
+        }
+        inside |= edge_in_extent[e] != 0;
+      }
+      // Beyond the blade's extent the walk stops.
+      if (!inside)
+        continue;
+      for (unsigned int f = 0; f < 4; ++f)
+      {
+        const unsigned int n = mesh.neighbor(t, f);
+        if (n != mesh::invalid_index && tet_walk[n] != walk && crosses(t, f))
+        {
+          tet_walk[n] = walk;
+          walk_queue.push_back(n);
+        }
+      }
+    }
+    // In spring order, as a scan would find them: the sums over them do not depend
+    // on the walk.
+    std::sort(crossings.begin(),
+              crossings.end(),
+              [](const Crossing &x, const Crossing &y) { return x.spring < y.spring; });
   }
 
 
@@ -379,10 +483,13 @@ namespace lacerta::cut
     l.normal = norm(normal) > 0 ? normalized(normal) : e;
     // The section of the body by the plane, sampled by the springs crossing it: its
     // long axis is the way the tear runs, its short axis (the thickness) the blade's.
-    l.across    = l.normal; // unused by the unrestricted search below
-    l.across_lo = -std::numeric_limits<double>::infinity();
-    l.across_hi = std::numeric_limits<double>::infinity();
-    find_crossings(l);
+    l.across                = l.normal; // unused by the unrestricted search below
+    l.across_lo             = -std::numeric_limits<double>::infinity();
+    l.across_hi             = std::numeric_limits<double>::infinity();
+    const auto search_start = Clock::now();
+    find_crossings(l, seed.tet);
+    s.search_seconds +=
+      std::chrono::duration<double>(Clock::now() - search_start).count();
     const Point helper =
       std::abs(l.normal[0]) < 0.9 ? Point{{1, 0, 0}} : Point{{0, 1, 0}};
     const Point e1 = normalized(cross(l.normal, helper));
@@ -426,7 +533,10 @@ namespace lacerta::cut
       l.across_hi = -l.across_hi;
     }
     l.end = hi;
-    find_crossings(l);
+    // The blade's extent holds every crossing found: only their positions along the
+    // new direction change.
+    for (Crossing &c : crossings)
+      c.along = dot(l.advance, sub(c.at, l.origin));
     lacerations.push_back(l);
     // Up to one band past the seed the tear runs whatever the stress: the seed spring
     // must break and the tear must reach the surface.
@@ -492,8 +602,11 @@ namespace lacerta::cut
               || (std::abs(dot(l.normal, r)) <= l.edge && u > l.stop - l.edge
                   && u <= l.stop + 2 * l.edge)))
       {
-        s.continued = true;
-        find_crossings(l);
+        s.continued             = true;
+        const auto search_start = Clock::now();
+        find_crossings(l, seed.tet);
+        s.search_seconds +=
+          std::chrono::duration<double>(Clock::now() - search_start).count();
         // Without its cutter (the particle system was replaced) a new one starts at
         // the tip, with the laceration's particles on its plane as its crack
         // (advance()).

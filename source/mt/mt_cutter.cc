@@ -301,6 +301,37 @@ namespace lacerta::mt
     }
     if (surface.empty())
       return statistics;
+    // An earlier surface that ended inside tetrahedra (a partial tear or stroke; the
+    // crack closed there, step 4) is cut again with these records if they reach those
+    // tetrahedra: a continuation's records start at the old crack front, inside them,
+    // and alone they would end there too and close the crack again (at a coarse level
+    // whose cells all contain the old front, the continued tear never separated).
+    // Only a surface that meets the kept one continues it: a stroke elsewhere, even
+    // through the same coarse cells, leaves it alone (cutting it again there would
+    // open faces whose corners all lie on it beyond where it ends).
+    bool reaches_kept = false;
+    for (std::size_t k = 0; k < surface.size() && !reaches_kept; ++k)
+    {
+      cut::Box box;
+      for (const Point &p : surface[k])
+        box.extend(p);
+      for (std::size_t j = 0; j < kept_surface.size() && !reaches_kept; ++j)
+      {
+        cut::Box kept_box;
+        for (const Point &p : kept_surface[j])
+          kept_box.extend(p);
+        reaches_kept = box.overlaps(kept_box);
+      }
+    }
+    if (reaches_kept)
+      for (std::size_t k = 0; k < kept_surface.size(); ++k)
+      {
+        add_triangle(kept_surface[k], kept_normal[k]);
+        cut::Box box;
+        for (const Point &p : kept_surface[k])
+          box.extend(p);
+        regions.push_back(box);
+      }
     // The surface triangles near a box (each at most once per call).
     std::vector<std::uint32_t> triangle_seen(surface.size(), 0);
     std::uint32_t              triangle_stamp = 0;
@@ -470,6 +501,7 @@ namespace lacerta::mt
     // cutter left), the table refines it without separating: the points on its cut
     // edges are not separated in any tetrahedron, so the crack closes there.
     std::set<std::pair<std::uint32_t, std::uint32_t>> closed;
+    std::vector<cut::Box>                             closed_tets;
     for (const std::uint32_t t : candidates)
     {
       Split s;
@@ -479,11 +511,39 @@ namespace lacerta::mt
       if (kind == cut::CutKind::none)
         continue;
       if (kind != cut::CutKind::complete && kind != cut::CutKind::touch)
+      {
+        closed_tets.push_back(tet_box(t));
         for (unsigned int e = 0; e < 6; ++e)
           if ((s.cut.cut_edges >> e) & 1u)
             closed.insert(edge_key(s.cut.vertex_ids[cut::tet_edge_vertices[e][0]],
                                    s.cut.vertex_ids[cut::tet_edge_vertices[e][1]]));
+      }
       splits.push_back(s);
+    }
+
+    // The surface near the tetrahedra in which it ended is kept for a continuation
+    // (what was kept before is part of this surface if it was cut again).
+    if (reaches_kept)
+    {
+      kept_surface.clear();
+      kept_normal.clear();
+    }
+    if (!closed_tets.empty())
+    {
+      // The triangles in the grid cells those tetrahedra's boxes meet, each once.
+      ++triangle_stamp;
+      for (const cut::Box &box : closed_tets)
+        for_each_cell(box,
+                      [&](const std::size_t k)
+                      {
+                        for (const std::uint32_t t : surface_cells[k])
+                          if (triangle_seen[t] != triangle_stamp)
+                          {
+                            triangle_seen[t] = triangle_stamp;
+                            kept_surface.push_back(surface[t]);
+                            kept_normal.push_back(normal[t]);
+                          }
+                      });
     }
 
     // 4. The children, with the cut points merged by edge and side, and the vertices
@@ -542,10 +602,37 @@ namespace lacerta::mt
         child_split.push_back(k);
       }
     }
+    // The tetrahedra around a vertex on the cut that the table leaves whole (the
+    // surface does not cross them, though their vertices lie on both sides: it ends
+    // nearby) keep the vertex and connect the children around them: left out, two
+    // groups joined only through them got different vertices, and the faces between
+    // them opened off the surface (a flap at the old tip of a continued tear).
+    // The split tetrahedra are marked in `seen` with a stamp of their own.
+    seen.resize(mt.n_tets(), 0);
+    if (++stamp == 0)
+    {
+      std::fill(seen.begin(), seen.end(), 0);
+      stamp = 1;
+    }
+    for (const Split &s : splits)
+      seen[s.tet] = stamp;
     for (const auto &[v, list] : incident)
     {
-      std::vector<std::size_t> group(list.size());
-      for (std::size_t i = 0; i < list.size(); ++i)
+      std::vector<mesh::Tet>    members;
+      std::vector<std::uint8_t> member_cut_faces;
+      for (const std::size_t c : list)
+      {
+        members.push_back(children[c]);
+        member_cut_faces.push_back(child_cut_faces[c]);
+      }
+      for (const std::uint32_t t : vertex_tets[v])
+        if (seen[t] != stamp && mt.is_live(t))
+        {
+          members.push_back(mt.tets[t]);
+          member_cut_faces.push_back(0);
+        }
+      std::vector<std::size_t> group(members.size());
+      for (std::size_t i = 0; i < members.size(); ++i)
         group[i] = i;
       const auto find = [&](std::size_t i)
       {
@@ -554,12 +641,12 @@ namespace lacerta::mt
         return i;
       };
       std::map<std::array<std::uint32_t, 3>, std::size_t> first_with_face;
-      for (std::size_t i = 0; i < list.size(); ++i)
+      for (std::size_t i = 0; i < members.size(); ++i)
       {
-        const mesh::Tet &t = children[list[i]];
+        const mesh::Tet &t = members[i];
         for (unsigned int f = 0; f < 4; ++f)
         {
-          if (t[f] == v || ((child_cut_faces[list[i]] >> f) & 1u))
+          if (t[f] == v || ((member_cut_faces[i] >> f) & 1u))
             continue;
           std::array<std::uint32_t, 3> face{
             {t[(f + 1) % 4], t[(f + 2) % 4], t[(f + 3) % 4]}};
@@ -569,7 +656,11 @@ namespace lacerta::mt
             group[find(i)] = find(it->second);
         }
       }
+      // The groups of the whole tetrahedra keep the vertex, every other group gets a
+      // copy.
       std::map<std::size_t, std::uint32_t> copy_of_root;
+      for (std::size_t i = list.size(); i < members.size(); ++i)
+        copy_of_root.emplace(find(i), v);
       for (std::size_t i = 0; i < list.size(); ++i)
       {
         const std::size_t root = find(i);

@@ -199,6 +199,13 @@ namespace
     return 0.3;
   }
 
+  /// Slightly weaker towards y = 1, so that a uniform stretch seeds the tear there.
+  double
+  weaker_towards_y1(const dealii::Point<3> &p)
+  {
+    return 0.3 - 0.02 * p[1];
+  }
+
 
   /**
    * Tears @p f once and checks a partial tear: from the rim y = 1, stopping inside
@@ -323,34 +330,70 @@ TEST(CutLaceration, AStoppedTearContinuesFromItsTipWhenThePullGrows)
 }
 
 
+namespace
+{
+  /**
+   * Cuts the slab of @p f along y = 0.2 with a scalpel through the whole thickness
+   * and across a tear's plane x = 0.4375, in 30 steps, checking every invariant after
+   * each: the strip y < 0.2 comes off.
+   */
+  void
+  cut_off_the_strip(TearFixture &f)
+  {
+    const auto blade = [](const double x) -> cut::Blade {
+      return {{{x, 0.2, 0.5}}, {{x, 0.2, -0.25}}};
+    };
+    cut::Cutter cutter(f.mesh,
+                       *f.system,
+                       f.density,
+                       f.youngs,
+                       f.integral,
+                       cut::Cutter::Parameters(),
+                       blade(-0.5));
+    for (unsigned int k = 1; k <= 30; ++k)
+    {
+      cutter.move_blade(blade(-0.5 + 2.5 * k / 30));
+      f.expect_invariants("scalpel step " + std::to_string(k));
+      if (::testing::Test::HasFatalFailure())
+        return;
+    }
+  }
+} // namespace
+
+
 TEST(CutLaceration, LaceratedThenCutKeepsEveryInvariant)
 {
   TearFixture f(stretch_x(0.4), weak_near_one_edge, 3);
   ASSERT_TRUE(f.lacerator->check().torn);
-  // A scalpel across the torn slab along y = 0.2, through the whole thickness and
-  // across the tear's plane: the crack and the cut cross.
-  const auto blade = [](const double x) -> cut::Blade {
-    return {{{x, 0.2, 0.5}}, {{x, 0.2, -0.25}}};
-  };
-  cut::Cutter cutter(f.mesh,
-                     *f.system,
-                     f.density,
-                     f.youngs,
-                     f.integral,
-                     cut::Cutter::Parameters(),
-                     blade(-0.5));
-  for (unsigned int k = 1; k <= 30; ++k)
-  {
-    cutter.move_blade(blade(-0.5 + 2.5 * k / 30));
-    f.expect_invariants("scalpel step " + std::to_string(k));
-    ASSERT_FALSE(::testing::Test::HasFatalFailure());
-  }
+  // The crack and the cut cross.
+  cut_off_the_strip(f);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
   // The scalpel separated the strip y < 0.2 (at rest); the tear did not reach it.
   EXPECT_EQ(cut::count_components(f.mesh), 2u);
   // The lacerator sees the new faces and stays consistent.
   f.lacerator->mesh_changed();
   f.lacerator->check();
   f.expect_invariants("after a second check");
+}
+
+
+TEST(CutLaceration, ATearStaysInThePieceItStartsIn)
+{
+  // A uniform stretch past the limit everywhere (the most at the rim y = 1, where the
+  // tear starts), after a scalpel separated the strip y < 0.2: the tear's plane
+  // crosses both pieces, but the springs crossing it are found by walking from the
+  // seed, so only the seed's piece tears through (3 pieces). A search over every
+  // spring crossing the plane tore both (4 pieces).
+  TearFixture f(stretch_x(0.4), weaker_towards_y1, 3);
+  cut_off_the_strip(f);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  ASSERT_EQ(cut::count_components(f.mesh), 2u);
+  f.lacerator->mesh_changed();
+  const cut::LacerationStatistics tear = f.lacerator->check();
+  ASSERT_TRUE(tear.torn);
+  EXPECT_TRUE(tear.complete);
+  f.expect_invariants("after the tear");
+  EXPECT_EQ(cut::count_components(f.mesh), 3u);
 }
 
 

@@ -16,6 +16,7 @@
 
 #include "mt_test_support.h"
 #include "physics_test_support.h"
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -115,6 +116,26 @@ namespace lacerta
                   * cut::norm(cut::cross(cut::sub(m.vertex(t[l[1]]), m.vertex(t[l[0]])),
                                          cut::sub(m.vertex(t[l[2]]), m.vertex(t[l[0]]))));
         }
+      return area;
+    }
+
+    /// Area of the boundary faces of @p m that lie on the plane x = @p x0, at rest.
+    double
+    area_on_plane(const mesh::TetMesh &m, const double x0)
+    {
+      double area = 0;
+      for (const auto &f : m.get_boundary_faces())
+      {
+        const auto      &l        = mesh::TetMesh::face_vertices[f.face];
+        const mesh::Tet &t        = m.tet(f.tet);
+        bool             on_plane = true;
+        for (const unsigned int k : l)
+          on_plane &= std::abs(m.vertex(t[k])[0] - x0) < 1e-9;
+        if (on_plane)
+          area += 0.5
+                  * cut::norm(cut::cross(cut::sub(m.vertex(t[l[1]]), m.vertex(t[l[0]])),
+                                         cut::sub(m.vertex(t[l[2]]), m.vertex(t[l[0]]))));
+      }
       return area;
     }
 
@@ -252,22 +273,18 @@ namespace lacerta
     expect_scene_invariants(*scene, "on the MT's version of the continued tear");
     // The continuation's cutter takes the tear's particles on its plane as its crack
     // (the opened faces and the points where the MT closed the crack at the first
-    // tip), so it opens the cells at the old tip too: the slab is in two pieces on the
-    // level of detail, at the finest and at a middle level. The finest shows the whole
-    // section (1 x 0.25, both sides; 0.5 m^2 measured on the plane, as the cutter
-    // opened it on the level of detail) plus a flap that the second MT update opens in
-    // the cell row at the old tip, faces from the plane to the next vertex column
-    // (0.038 m^2 measured, y in [0.5, 0.625]): at most that row (tip_row) more.
+    // tip), so it opens the cells at the old tip too; the MT update cuts with the
+    // first tear's surface kept near the cells where it closed and the continuation's
+    // together. The slab is in two pieces on the level of detail and at every level,
+    // and the finest level's boundary has grown by exactly the two faces of the
+    // section by the plane (1 x 0.25 each), nothing more: no flap at the old tip.
     EXPECT_EQ(cut::count_components(scene->active_mesh()), 2u);
     const mesh::TetMesh through        = extract(mt, 0, 2, "after the second pull");
     const double        through_opened = test_support::boundary_area(through) - slab_area;
-    EXPECT_GT(through_opened, 0.98 * 2 * thickness);
-    EXPECT_LT(through_opened, 2 * thickness + tip_row);
-    extract(mt, 0.3, 2, "after the second pull");
-    // The coarsest level's few cells all contain the first tip: the first MT update
-    // closed the crack in them and the continuation's surface starts at that tip, so
-    // it closes there again (doc/lacerations.md, "Limits").
-    extract(mt, 1000, 1, "after the second pull");
+    EXPECT_NEAR(through_opened, 2 * thickness, 1e-9);
+    EXPECT_NEAR(area_on_plane(through, 0.4375), 2 * thickness, 1e-9);
+    for (const double h : {0.3, 0.5, 1000.0})
+      extract(mt, h, 2, "after the second pull");
   }
 
 

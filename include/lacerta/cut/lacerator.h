@@ -49,6 +49,8 @@ namespace lacerta::cut
     unsigned int cut_tets = 0, created_tets = 0, new_particles = 0;
     /// Wall time of the tear (plane, blade and the cutter's updates), in seconds.
     double update_seconds = 0;
+    /// The part of it spent finding the springs that cross the tear's plane.
+    double search_seconds = 0;
     /// Whether the mesh changed (then the integrator must be re-initialised).
     bool changed = false;
     /// Particles the tear copied along its surface, (original, copy): constraints
@@ -165,6 +167,8 @@ namespace lacerta::cut
     {
       unsigned int a, b;
       double       rest_length, limit;
+      /// A tetrahedron with the spring on one of its boundary faces.
+      unsigned int tet;
     };
 
     /// A laceration surface: plane, directions of advance and across, and progress.
@@ -191,6 +195,8 @@ namespace lacerta::cut
       Point        at;
       double       along;
       unsigned int a, b;
+      /// The spring's index (the mesh's edge id), which orders the crossings.
+      unsigned int spring;
     };
 
     /// The maximum elongation at rest point @p x, checked against its range.
@@ -209,9 +215,14 @@ namespace lacerta::cut
     bool
     in_wake(const Point &x) const;
 
-    /// The springs crossing the plane of @p l, with their positions along it.
+    /**
+     * The springs crossing the plane of @p l within the blade's extent, with their
+     * positions along it, in spring order: the part of the section connected to
+     * tetrahedron @p seed_tet (all springs if no tetrahedron near it crosses the
+     * plane).
+     */
     void
-    find_crossings(const Laceration &l);
+    find_crossings(const Laceration &l, unsigned int seed_tet);
 
     /// The blade of @p l when its front is at @p along.
     Blade
@@ -246,7 +257,14 @@ namespace lacerta::cut
     /// The heap of over-stretched surface springs: (ratio, index into `surface`).
     std::vector<std::pair<double, unsigned int>> heap;
     std::vector<Crossing>                        crossings;
-    std::vector<Laceration>                      lacerations;
+    /// Working arrays of find_crossings(), kept between tears so that a walk touches
+    /// only the section: per tetrahedron and per edge the last walk that reached it
+    /// (and whether the edge crosses the plane within the blade's extent).
+    std::vector<unsigned int> tet_walk, edge_walk;
+    std::vector<std::uint8_t> edge_in_extent;
+    std::vector<unsigned int> walk_queue, walk_ring, walk_next_ring;
+    unsigned int              walk = 0;
+    std::vector<Laceration>   lacerations;
     /// For every particle, the laceration that created it (or none).
     std::vector<unsigned int> sheet;
     unsigned int              tears = 0;

@@ -30,10 +30,13 @@ namespace lacerta::mt
    * ε·|edge| of a vertex puts the vertex on the cut), the side of every vertex, so a
    * tetrahedron shared by two fragments, and faces shared by neighbours at any level
    * of detail, split alike. Only complete cuts separate: where the soup ends inside a
-   * tetrahedron (a crack front) the crack retreats to the last tetrahedra it crosses
-   * completely. Cut points are merged by edge and side; a vertex on the cut gets one
-   * copy per group of children around it connected through faces not on the cut, over
-   * all levels at once, as the cutter does within one mesh.
+   * tetrahedron (a crack front) the crack closes along its cut edges; the surface near
+   * those tetrahedra is kept and cut again with later records whose surface meets it,
+   * so that a crack continued from its front opens there too. Cut points are merged by
+   * edge and side; a vertex on the cut gets one copy per group of children around it
+   * connected through faces not on the cut (tetrahedra around it that the table leaves
+   * whole keep it and connect the groups), over all levels at once, as the cutter does
+   * within one mesh.
    *
    * Children keep the creator and destroyer of the tet they replace: the node's
    * fragments list them instead of the parent (MultiTriangulation::cut_fine,
@@ -133,6 +136,12 @@ namespace lacerta::mt
     std::vector<std::vector<std::uint32_t>> cells;
     /// Per vertex: the tets containing it (replaced ones included; filtered on use).
     std::vector<std::vector<std::uint32_t>> vertex_tets;
+    /// The triangles of earlier cut surfaces near the tetrahedra in which they ended
+    /// (the crack closed there), with their normals towards +1: cut again together
+    /// with later records whose surface meets them, so that a continuation (a tear
+    /// continued after the update) completes the crack.
+    std::vector<std::array<cut::Point, 3>> kept_surface;
+    std::vector<cut::Point>                kept_normal;
     /// Per tet: the last query() that returned it.
     std::vector<std::uint32_t> seen;
     std::uint32_t              stamp = 0;
