@@ -661,8 +661,39 @@ namespace lacerta::cut
     // where it is now says little about whether a plane that continues the cut holds
     // it. Whether it is on the plane, and reached, is judged where it joined the crack.
     const double tolerance = parameters.snap_fraction * typical_edge;
-    const Point  at        = on_surface[v] ? joined_at[v] : x;
-    s.on_plane = d == 0 || (on_surface[v] && std::abs(surface.distance(at)) <= tolerance);
+    Point        at        = on_surface[v] ? joined_at[v] : x;
+    bool         on_crack  = on_surface[v] && std::abs(surface.distance(at)) <= tolerance;
+    // Where the flap twists (square_hole's fourth side crossing the first side's
+    // crack), neither place puts a crack vertex on the plane: it is then judged in
+    // the rest frame of the tissue the blade is in, where crack vertices never move
+    // (the plane meets the crack where it did at rest). The vertex's rest position
+    // is mapped through the deformation of the blade's cells (the mean of their
+    // affine maps), so that the test compares rest geometry in world units. Not while
+    // the front is brought to a corner or has just turned there: the blade's cells
+    // then hold the other side's crack (with the test there too, square_hole's third
+    // corner stayed uncut between rest x = -0.0125 and -0.02).
+    if (on_surface[v] && !on_crack && !active.empty() && !catching_up && !after_corner)
+    {
+      const Point &rest   = mesh.vertex(v);
+      Point        mapped = {{0, 0, 0}};
+      for (const unsigned int t : active)
+      {
+        const mesh::Tet &c = mesh.tet(t);
+        const auto       l = barycentric(mesh.vertex(c[0]),
+                                   mesh.vertex(c[1]),
+                                   mesh.vertex(c[2]),
+                                   mesh.vertex(c[3]),
+                                   rest);
+        for (unsigned int i = 0; i < 4; ++i)
+          mapped = add(mapped, scale(l[i] / active.size(), position(c[i])));
+      }
+      if (std::abs(surface.distance(mapped)) <= tolerance)
+      {
+        on_crack = true;
+        at       = mapped;
+      }
+    }
+    s.on_plane = d == 0 || on_crack;
     // Reached: a vertex of the crack when behind the new front; a fresh one when also
     // not behind the start of this sweep by more than a cell (the plane must not
     // reach back along an older part of the crack), or when an earlier sweep of the

@@ -15,9 +15,12 @@
 
 #include "cut_split_support.h"
 #include "physics_test_support.h"
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <random>
 
 namespace
@@ -205,9 +208,12 @@ TEST(CutCutter, RandomStrokesKeepTheInvariants)
 namespace
 {
   /// Volumes of the pieces after a square loop (side 0.4) cut in @p steps steps per
-  /// side through the box of 4^3 cubes, entering from above and lifted out.
+  /// side through the box of 4^3 cubes, entering from above and lifted out at
+  /// y = @p end_y; @p motion, if set, moves the tissue after every step of the loop.
   std::vector<double>
-  punch_square(const unsigned int steps)
+  punch_square(const unsigned int                                          steps,
+               const double                                                end_y  = 0.25,
+               const std::function<void(CutFixture &, unsigned int step)> &motion = {})
   {
     std::mt19937 rng(5);
     // A square loop inside the box, passing its start again: the inside drops out.
@@ -215,13 +221,17 @@ namespace
                                      vertical(0.7, 0.3),
                                      vertical(0.7, 0.7),
                                      vertical(0.3, 0.7),
-                                     vertical(0.3, 0.25)};
+                                     vertical(0.3, end_y)};
     // The blade enters from above, runs the loop and is lifted out.
-    const Blade above{{{0.3, 0.3, 2.5}}, {{0.3, 0.3, 1.2}}};
-    const Blade lifted{{{0.3, 0.25, 2.5}}, {{0.3, 0.25, 1.2}}};
-    CutFixture  f(4, rng, above);
+    const Blade  above{{{0.3, 0.3, 2.5}}, {{0.3, 0.3, 1.2}}};
+    const Blade  lifted{{{0.3, end_y, 2.5}}, {{0.3, end_y, 1.2}}};
+    CutFixture   f(4, rng, above);
+    unsigned int step = 0;
     f.stroke({above, loop[0]}, 4);
+    if (motion)
+      f.after_step = [&](const cut::CutStepStatistics &) { motion(f, ++step); };
     f.stroke(loop, steps);
+    f.after_step = nullptr;
     f.stroke({loop.back(), lifted}, 4);
     if (::testing::Test::HasFatalFailure())
       return {};
@@ -377,6 +387,25 @@ TEST(CutCutter, SimulationStaysStableAfterACompleteCut)
 
 namespace
 {
+  /// The mean rest centroid of the cells of vertex @p v (none if it has no cells):
+  /// which side of a crack its copy belongs to.
+  std::optional<Point>
+  mean_rest_centroid(const mesh::TetMesh &mesh, const unsigned int v)
+  {
+    const auto &cells = mesh.tets_of_vertex(v);
+    if (cells.empty())
+      return std::nullopt;
+    Point c{{0, 0, 0}};
+    for (const unsigned int t : cells)
+      for (const unsigned int w : mesh.tet(t))
+        for (unsigned int d = 0; d < 3; ++d)
+          c[d] += 0.25 * mesh.vertex(w)[d];
+    for (unsigned int d = 0; d < 3; ++d)
+      c[d] /= cells.size();
+    return c;
+  }
+
+
   /**
    * Opens the crack of a cut along the rest plane y = @p y_cut the way a stretched
    * tissue does once cut: every particle is moved along y, away from the plane, by
@@ -392,17 +421,12 @@ namespace
   {
     for (unsigned int v = 0; v < system.n_particles(); ++v)
     {
-      const auto &cells = mesh.tets_of_vertex(v);
-      if (cells.empty())
+      const auto c = mean_rest_centroid(mesh, v);
+      if (!c)
         continue;
-      double c = 0;
-      for (const unsigned int t : cells)
-        for (const unsigned int w : mesh.tet(t))
-          c += 0.25 * mesh.vertex(w)[1];
-      c /= cells.size();
       for (unsigned int d = 0; d < 3; ++d)
         system.position[3 * v + d] = mesh.vertex(v)[d];
-      system.position[3 * v + 1] += opening * std::tanh((c - y_cut) / 0.1);
+      system.position[3 * v + 1] += opening * std::tanh(((*c)[1] - y_cut) / 0.1);
     }
   }
 } // namespace
@@ -440,4 +464,67 @@ TEST(CutCutter, CrackThatOpensBehindTheFrontStillSeparates)
     // y fixed, and snapping moves the surface by at most that.
     EXPECT_NEAR(pieces[0], y, 0.0125) << where;
   }
+}
+
+
+namespace
+{
+  /**
+   * Moves the square flap of punch_square() the way square_hole's flap relaxes once
+   * cut on a few sides: every particle is put at its rest position plus a motion
+   * towards -x of @p shift at mid-height that grows towards the bottom by @p twist
+   * (per unit of depth below mid-height), weighted by how far inside the square
+   * [0.3, 0.7]^2 the mean rest centroid of its cells is (smoothly, over a tenth).
+   * The two copies of a crack vertex belong to cells on their own side: the flap's
+   * copies move, the surrounding tissue's stay.
+   */
+  void
+  move_flap(const mesh::TetMesh     &mesh,
+            physics::ParticleSystem &system,
+            const double             shift,
+            const double             twist)
+  {
+    const auto inside = [](const double s)
+    { return 0.5 * (1 + std::tanh(std::min(s - 0.3, 0.7 - s) / 0.05)); };
+    for (unsigned int v = 0; v < system.n_particles(); ++v)
+    {
+      const auto c = mean_rest_centroid(mesh, v);
+      if (!c)
+        continue;
+      const double weight = inside((*c)[0]) * inside((*c)[1]);
+      for (unsigned int d = 0; d < 3; ++d)
+        system.position[3 * v + d] = mesh.vertex(v)[d];
+      system.position[3 * v] -=
+        weight * (shift + twist * std::max(0.0, 0.5 - mesh.vertex(v)[2]));
+    }
+  }
+} // namespace
+
+
+// square_hole (doc/cutting.md, Limits): the flap, cut on three sides, drifts and
+// twists towards the fourth side, so that where the fourth side crosses the first
+// side's crack the crack's vertices are on the fourth side's plane neither where they
+// joined the crack nor where they are now; the plane cut next to them and left a
+// strip of the first crack's cells joining the square to the rest. They are judged
+// in the rest frame of the cells the blade is in.
+TEST(CutCutter, SelfCrossingOverATwistingCrackPunchesTheSquare)
+{
+  // The flap drifts from the middle of the third side on, fully by the middle of the
+  // fourth, where the blade crosses the first side's crack.
+  const unsigned int steps = 20;
+  const auto         pieces =
+    punch_square(steps,
+                 0.2,
+                 [](CutFixture &f, const unsigned int step)
+                 {
+                   const double s =
+                     std::clamp((double(step) - 2.5 * steps) / double(steps), 0.0, 1.0);
+                   move_flap(f.mesh, *f.system, 0.02 * s, 0.1 * s);
+                 });
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  std::string listing;
+  for (const double v : pieces)
+    listing += " " + std::to_string(v);
+  ASSERT_EQ(pieces.size(), 2u) << "pieces:" << listing;
+  EXPECT_NEAR(pieces[0] + pieces[1], 1.0, 1e-12);
 }
