@@ -508,8 +508,11 @@ namespace lacerta::mesh
                             std::vector<unsigned int> &out) const
   {
     for (const unsigned int t : vertex_tets[a])
-      if (std::find(tets[t].begin(), tets[t].end(), b) != tets[t].end())
+    {
+      const Tet &q = tets[t];
+      if (q[0] == b || q[1] == b || q[2] == b || q[3] == b)
         out.push_back(t);
+    }
   }
 
 
