@@ -29,22 +29,24 @@ namespace lacerta::cut
     /// from the direction since the crack front makes a corner of the path.
     constexpr double corner_angle = 0.3;
 
-    /// Whether local node @p n of a child lies on local face @p f of its parent.
-    bool
-    node_on_parent_face(const NodeRef &n, const unsigned int f)
+    /// The local faces of its parent that local node @p n of a child lies on, one bit
+    /// per face.
+    unsigned int
+    parent_faces_of_node(const NodeRef &n)
     {
       switch (n.kind)
       {
         case NodeKind::vertex:
-          return n.index != f;
+          return 0xFu & ~(1u << n.index);
         case NodeKind::edge_point:
-          return tet_edge_vertices[n.index][0] != f && tet_edge_vertices[n.index][1] != f;
+          return 0xFu & ~(1u << tet_edge_vertices[n.index][0])
+                 & ~(1u << tet_edge_vertices[n.index][1]);
         case NodeKind::face_point:
-          return n.index == f;
+          return 1u << n.index;
         case NodeKind::interior_point:
-          return false;
+          return 0;
       }
-      return false;
+      return 0;
     }
   } // namespace
 
@@ -945,8 +947,33 @@ namespace lacerta::cut
     const mesh::Tet                  &tet = mesh.tet(t);
     const auto                       &fv  = mesh::TetMesh::face_vertices[f];
     const std::array<unsigned int, 3> v{{tet[fv[0]], tet[fv[1]], tet[fv[2]]}};
-    std::array<SectionCorner, 3>      corners;
-    unsigned int                      n_corners = 0, vertex_corners = 0;
+    // Most faces have no front point: front_point_on_face() wants a segment (two
+    // corners) between a reached and an unreached corner, not two vertex corners.
+    // Counting the corners first spares those faces the interpolations.
+    {
+      unsigned int n = 0, n_vertex = 0, n_reached = 0;
+      for (unsigned int k = 0; k < 3; ++k)
+        if (vertex_scratch[v[k]].on_plane)
+        {
+          ++n;
+          ++n_vertex;
+          n_reached += vertex_scratch[v[k]].reached ? 1 : 0;
+        }
+      for (unsigned int k = 0; k < 3 && n < 3; ++k)
+      {
+        const EdgeScratch &es =
+          edge_scratch[mesh.tet_edges(t)[tet_edge_of_vertices[fv[k]][fv[(k + 1) % 3]]]];
+        if (es.crossing)
+        {
+          ++n;
+          n_reached += es.reached ? 1 : 0;
+        }
+      }
+      if (n != 2 || n_reached != 1 || n_vertex == 2)
+        return;
+    }
+    std::array<SectionCorner, 3> corners;
+    unsigned int                 n_corners = 0, vertex_corners = 0;
     for (unsigned int k = 0; k < 3; ++k)
       if (vertex_scratch[v[k]].on_plane)
       {
@@ -1064,6 +1091,16 @@ namespace lacerta::cut
         statistics.cut_tets += 1;
         statistics.created_tets += r.n_children;
       }
+      // The parent's boundary ids, looked up once for all its children (most
+      // parents are inside the body and have none).
+      std::array<unsigned int, 4> parent_ids;
+      unsigned int                parent_boundary = 0;
+      for (unsigned int f = 0; f < 4; ++f)
+      {
+        parent_ids[f] = mesh.boundary_id(parent, f);
+        if (parent_ids[f] != mesh::invalid_index)
+          parent_boundary |= 1u << f;
+      }
       for (unsigned int i = 0; i < r.n_children; ++i)
       {
         const Child &child = r.children[i];
@@ -1153,17 +1190,17 @@ namespace lacerta::cut
             fid[j] = cut_boundary_id;
             continue;
           }
-          // A face on a parent's boundary face keeps its boundary id.
+          // A face on a parent's boundary face keeps its boundary id: the parent's
+          // faces that all three of its nodes lie on (the last such face wins).
+          if (parent_boundary == 0)
+            continue;
+          unsigned int on = parent_boundary;
+          for (unsigned int m = 0; m < 4; ++m)
+            if (m != j)
+              on &= parent_faces_of_node(child.nodes[m]);
           for (unsigned int f = 0; f < 4; ++f)
-          {
-            bool on = true;
-            for (unsigned int m = 0; m < 4; ++m)
-              if (m != j)
-                on = on && node_on_parent_face(child.nodes[m], f);
-            const unsigned int id = mesh.boundary_id(parent, f);
-            if (on && id != mesh::invalid_index)
-              fid[j] = id;
-          }
+            if (on & (1u << f))
+              fid[j] = parent_ids[f];
         }
         children.push_back(t);
         if (record)

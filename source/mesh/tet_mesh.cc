@@ -467,18 +467,36 @@ namespace lacerta::mesh
   TetMesh::find_edge(const unsigned int a, const unsigned int b) const
   {
     // Any tetrahedron with both ends has the edge: search the smaller star (a vertex
-    // just made by a cut has an empty one).
+    // just made by a cut has an empty one). A cell of u's star has u, so it has the
+    // edge if it also has w: four comparisons instead of two for each of six edges
+    // (the searches for retired edges in replace_tets() go through the whole star).
     const bool         from_a = vertex_tets[a].size() <= vertex_tets[b].size();
     const unsigned int u = from_a ? a : b, w = from_a ? b : a;
     for (const unsigned int t : vertex_tets[u])
     {
-      const Tet &q = tets[t];
-      for (unsigned int e = 0; e < 6; ++e)
-      {
-        const unsigned int p = q[edge_vertices[e][0]], r = q[edge_vertices[e][1]];
-        if ((p == u && r == w) || (p == w && r == u))
-          return tet_edge_ids[t][e];
-      }
+      const Tet   &q = tets[t];
+      unsigned int j = 0;
+      while (j < 4 && q[j] != w)
+        ++j;
+      if (j == 4)
+        continue;
+      unsigned int i = 0;
+      while (q[i] != u)
+        ++i;
+      if (i > j)
+        std::swap(i, j);
+      static_assert(
+        []
+        {
+          for (unsigned int e = 0; e < 6; ++e)
+            if (edge_vertices[e][0] + edge_vertices[e][1]
+                  - (edge_vertices[e][0] == 0 ? 1 : 0)
+                != e)
+              return false;
+          return true;
+        }(),
+        "local edge (i, j) is numbered i + j - [i == 0]");
+      return tet_edge_ids[t][i + j - (i == 0 ? 1 : 0)];
     }
     return invalid_index;
   }
@@ -490,8 +508,11 @@ namespace lacerta::mesh
                             std::vector<unsigned int> &out) const
   {
     for (const unsigned int t : vertex_tets[a])
-      if (std::find(tets[t].begin(), tets[t].end(), b) != tets[t].end())
+    {
+      const Tet &q = tets[t];
+      if (q[0] == b || q[1] == b || q[2] == b || q[3] == b)
         out.push_back(t);
+    }
   }
 
 
@@ -613,9 +634,14 @@ namespace lacerta::mesh
 
     // Take the old tets out: stars, boundary faces, neighbours' back links. Their
     // edges, once each (an edge id names one edge), are candidates for retirement.
+    // An edge of a new tet lives on: marking those first leaves as candidates only
+    // the edges that just the remaining old tets may still hold.
     auto &old_edges = scratch.old_edges;
     old_edges.clear();
     scratch.edge_stamp.resize(edges.size(), 0);
+    for (const auto &ids : new_edge_ids)
+      for (const unsigned int id : ids)
+        scratch.edge_stamp[id] = scratch.stamp;
     for (const unsigned int r : removed)
     {
       for (unsigned int e = 0; e < 6; ++e)

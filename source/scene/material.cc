@@ -86,9 +86,19 @@ namespace lacerta::scene
   Material::parse_parameters(dealii::ParameterHandler &prm)
   {
     prm.enter_subsection("Material");
-    const auto constants = parse_constants(prm.get("Function constants"));
-    density_function =
-      parse_function("Material/Density", prm.get("Density"), 1, false, constants);
+    const auto        constants = parse_constants(prm.get("Function constants"));
+    const std::string density   = prm.get("Density");
+    auto              density_parser =
+      parse_function("Material/Density", density, 1, false, constants);
+    // A plain number (digits, sign, point, exponent: no variable can appear) becomes
+    // a ConstantFunction, which the cut update recognises (physics::constant_value())
+    // to compute masses without a Function call per quadrature point. Its value is
+    // the parser's own, so no mass changes.
+    if (density.find_first_not_of("0123456789.eE+- \t") == std::string::npos)
+      density_function = std::make_unique<dealii::Functions::ConstantFunction<3>>(
+        density_parser->value(dealii::Point<3>()));
+    else
+      density_function = std::move(density_parser);
     youngs_function = parse_function(
       "Material/Youngs modulus", prm.get("Youngs modulus"), 1, false, constants);
     elongation_function = parse_function(

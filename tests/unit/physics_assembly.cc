@@ -1,6 +1,9 @@
 // Masses (Section 3.1) and spring stiffnesses (Section 3.2).
 
+#include <lacerta/scene/material.h>
+
 #include <deal.II/base/function_parser.h>
+#include <deal.II/base/parameter_handler.h>
 
 #include <gtest/gtest.h>
 
@@ -66,6 +69,38 @@ TEST(Assembly, ConstantDensityShortcutGivesTheSameMassesToTheLastBit)
   EXPECT_FALSE(physics::constant_value(parsed).has_value());
   EXPECT_FALSE(
     physics::constant_value(dealii::Functions::ConstantFunction<3>(1.0, 2)).has_value());
+}
+
+
+TEST(Assembly, NumericDensityIsAConstantFunctionWithTheParsersValue)
+{
+  // A density given as a plain number gets the cut update's constant-density
+  // shortcut, with the value the expression parser gives; an expression of x, y, z
+  // does not.
+  const auto density_of = [](const std::string &expression)
+  {
+    dealii::ParameterHandler prm;
+    scene::Material::declare_parameters(prm);
+    prm.enter_subsection("Material");
+    prm.set("Density", expression);
+    prm.leave_subsection();
+    scene::Material material;
+    material.parse_parameters(prm);
+    return material;
+  };
+  for (const std::string expression : {"1000", " 1.25e3 ", "0.1", "-2+7"})
+  {
+    const scene::Material     material = density_of(expression);
+    dealii::FunctionParser<3> parsed(1);
+    parsed.initialize("x,y,z", expression, {});
+    const auto sigma = physics::constant_value(material.density());
+    ASSERT_TRUE(sigma.has_value()) << expression;
+    EXPECT_EQ(*sigma, parsed.value(dealii::Point<3>())) << expression;
+    EXPECT_EQ(material.density().value(dealii::Point<3>(0.3, -1, 2)), *sigma);
+  }
+  const scene::Material varying = density_of("1000*(1 + x)");
+  EXPECT_FALSE(physics::constant_value(varying.density()).has_value());
+  EXPECT_EQ(varying.density().value(dealii::Point<3>(0.5, 0, 0)), 1500.0);
 }
 
 

@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include <deal.II/base/function.h>
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/parameter_handler.h>
 
@@ -13,7 +14,8 @@ namespace lacerta::scene
 {
   /**
    * Density σ(x) and Young's modulus E(x) as FunctionParser expressions of x, y, z
-   * (`subsection Material`), the Poisson ratio for the FEM reference, and damping.
+   * (`subsection Material`; a density that is a plain number is a ConstantFunction),
+   * the Poisson ratio for the FEM reference, and damping.
    */
   class Material
   {
@@ -62,7 +64,8 @@ namespace lacerta::scene
     double spring_damping = 0;
 
   private:
-    std::unique_ptr<dealii::FunctionParser<3>> density_function;
+    /// A ConstantFunction when the expression is a plain number, else its parser.
+    std::unique_ptr<dealii::Function<3>>       density_function;
     std::unique_ptr<dealii::FunctionParser<3>> youngs_function;
     std::unique_ptr<dealii::FunctionParser<3>> elongation_function;
   };
