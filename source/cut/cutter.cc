@@ -48,6 +48,16 @@ namespace lacerta::cut
       }
       return 0;
     }
+
+    /// Barycentric coordinates of the rest point @p rest in cell @p t of @p mesh:
+    /// the weights that carry it, with the cell's affine map, to the deformed state.
+    std::array<double, 4>
+    rest_barycentric(const mesh::TetMesh &mesh, const unsigned int t, const Point &rest)
+    {
+      const mesh::Tet &c = mesh.tet(t);
+      return barycentric(
+        mesh.vertex(c[0]), mesh.vertex(c[1]), mesh.vertex(c[2]), mesh.vertex(c[3]), rest);
+    }
   } // namespace
 
 
@@ -681,11 +691,7 @@ namespace lacerta::cut
       for (const unsigned int t : active)
       {
         const mesh::Tet &c = mesh.tet(t);
-        const auto       l = barycentric(mesh.vertex(c[0]),
-                                   mesh.vertex(c[1]),
-                                   mesh.vertex(c[2]),
-                                   mesh.vertex(c[3]),
-                                   rest);
+        const auto       l = rest_barycentric(mesh, t, rest);
         for (unsigned int i = 0; i < 4; ++i)
           mapped = add(mapped, scale(l[i] / active.size(), position(c[i])));
       }
@@ -1063,11 +1069,7 @@ namespace lacerta::cut
     const auto new_particle = [&](const Point &rest, const unsigned int parent)
     {
       const mesh::Tet &tet = mesh.tet(parent);
-      const auto       l   = barycentric(mesh.vertex(tet[0]),
-                                 mesh.vertex(tet[1]),
-                                 mesh.vertex(tet[2]),
-                                 mesh.vertex(tet[3]),
-                                 rest);
+      const auto       l   = rest_barycentric(mesh, parent, rest);
       Point            x{{0, 0, 0}}, v{{0, 0, 0}};
       for (unsigned int i = 0; i < 4; ++i)
         for (unsigned int c = 0; c < 3; ++c)
