@@ -82,9 +82,7 @@ namespace lacerta::cut
         for (unsigned int d = 0; d < 3; ++d)
           work[i].centre[d] = x[3 * f.vertices[0] + d] + x[3 * f.vertices[1] + d]
                               + x[3 * f.vertices[2] + d];
-        const Box &b = work[i].box;
-        sizes[i]     = std::max(
-          {b.upper[0] - b.lower[0], b.upper[1] - b.lower[1], b.upper[2] - b.lower[2]});
+        sizes[i] = work[i].box.size();
       }
       // The margin: a quarter of the median face size, so that a vertex crosses it
       // in many time steps (a stable step moves it by a small part of an edge) while
@@ -167,11 +165,7 @@ namespace lacerta::cut
       {
         for (unsigned int k = n.first; k < n.first + n.count; ++k)
           n.box.extend(face_box(faces[k], x));
-        for (unsigned int d = 0; d < 3; ++d)
-        {
-          n.box.lower[d] -= inflation;
-          n.box.upper[d] += inflation;
-        }
+        n.box.inflate(inflation);
       }
       else
       {

@@ -358,14 +358,8 @@ namespace lacerta::cut
     {
       corner         = last_end;
       corner_pending = true;
-      catching_up    = true;
-      sweep_once(corner, statistics);
-      catching_up  = false;
-      after_corner = after_corner || front.tail == corner.tail;
-      if (front.tail == corner.tail)
-        corner_pending = false;
     }
-    else if (corner_pending)
+    if (corner_pending)
     {
       catching_up = true;
       sweep_once(corner, statistics);
@@ -1353,15 +1347,7 @@ namespace lacerta::cut
       Box cell;
       for (const unsigned int v : mesh.tet(t))
         cell.extend(position(v));
-      const double margin = 0.1
-                            * std::max({cell.upper[0] - cell.lower[0],
-                                        cell.upper[1] - cell.lower[1],
-                                        cell.upper[2] - cell.lower[2]});
-      for (unsigned int d = 0; d < 3; ++d)
-      {
-        cell.lower[d] -= margin;
-        cell.upper[d] += margin;
-      }
+      cell.inflate(0.1 * cell.size());
       if (cell.overlaps(blade_box) && blade_in_tet(t, end))
         active.push_back(t);
     }

@@ -191,10 +191,7 @@ namespace lacerta::mt
     std::vector<cut::Box>                   regions;
     const auto add_triangle = [&](const std::array<Point, 3> &tri, const Point &n)
     {
-      cut::Box box;
-      for (const auto &p : tri)
-        box.extend(p);
-      for_each_cell(box,
+      for_each_cell(cut::Box::around(tri),
                     [&](const std::size_t k) {
                       surface_cells[k].push_back(
                         static_cast<std::uint32_t>(surface.size()));
@@ -290,10 +287,8 @@ namespace lacerta::mt
       u = cut::scale(rim_extension / length, u);
       if (cut::dot(u, cut::sub(c, a)) > 0)
         u = cut::scale(-1, u);
-      const Point a_out = cut::add(a, u), b_out = cut::add(b, u);
-      cut::Box    flap;
-      for (const Point &p : {a, b, a_out, b_out})
-        flap.extend(p);
+      const Point    a_out = cut::add(a, u), b_out = cut::add(b, u);
+      const cut::Box flap = cut::Box::around(std::array<Point, 4>{{a, b, a_out, b_out}});
       for (const std::array<Point, 3> &tri :
            {std::array<Point, 3>{{a, b, b_out}}, std::array<Point, 3>{{a, b_out, a_out}}})
         add_triangle(tri, n);
@@ -309,28 +304,23 @@ namespace lacerta::mt
     // Only a surface that meets the kept one continues it: a stroke elsewhere, even
     // through the same coarse cells, leaves it alone (cutting it again there would
     // open faces whose corners all lie on it beyond where it ends).
+    std::vector<cut::Box> kept_boxes;
+    for (const auto &tri : kept_surface)
+      kept_boxes.push_back(cut::Box::around(tri));
     bool reaches_kept = false;
     for (std::size_t k = 0; k < surface.size() && !reaches_kept; ++k)
     {
-      cut::Box box;
-      for (const Point &p : surface[k])
-        box.extend(p);
-      for (std::size_t j = 0; j < kept_surface.size() && !reaches_kept; ++j)
-      {
-        cut::Box kept_box;
-        for (const Point &p : kept_surface[j])
-          kept_box.extend(p);
-        reaches_kept = box.overlaps(kept_box);
-      }
+      const cut::Box box = cut::Box::around(surface[k]);
+      reaches_kept =
+        std::any_of(kept_boxes.begin(),
+                    kept_boxes.end(),
+                    [&](const cut::Box &kept) { return box.overlaps(kept); });
     }
     if (reaches_kept)
       for (std::size_t k = 0; k < kept_surface.size(); ++k)
       {
         add_triangle(kept_surface[k], kept_normal[k]);
-        cut::Box box;
-        for (const Point &p : kept_surface[k])
-          box.extend(p);
-        regions.push_back(box);
+        regions.push_back(kept_boxes[k]);
       }
     // The surface triangles near a box (each at most once per call).
     std::vector<std::uint32_t> triangle_seen(surface.size(), 0);

@@ -170,6 +170,35 @@ namespace lacerta::cut
       extend(b.upper);
     }
 
+    /// Grows the box by @p margin on every side.
+    void
+    inflate(const double margin)
+    {
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        lower[d] -= margin;
+        upper[d] += margin;
+      }
+    }
+
+    /// The largest extent of the box along an axis.
+    double
+    size() const
+    {
+      return std::max({upper[0] - lower[0], upper[1] - lower[1], upper[2] - lower[2]});
+    }
+
+    /// The box around the @p n points @p p.
+    template <std::size_t n>
+    static Box
+    around(const std::array<Point, n> &p)
+    {
+      Box box;
+      for (const Point &q : p)
+        box.extend(q);
+      return box;
+    }
+
     /// Whether the boxes overlap.
     bool
     overlaps(const Box &b) const
