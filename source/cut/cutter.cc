@@ -923,8 +923,28 @@ namespace lacerta::cut
       for (const unsigned int e : edge_list)
         if (edge_scratch[e].reached)
         {
+          // Usually every cell around the edge is in the set already: the smaller
+          // star of the two ends tells, testing the nodes of outside cells only.
+          // Otherwise the cells are listed in the mesh's order, as before.
+          const unsigned int a = edges[e][0], b = edges[e][1];
+          const bool         a_smaller =
+            mesh.tets_of_vertex(a).size() <= mesh.tets_of_vertex(b).size();
+          const unsigned int other   = a_smaller ? b : a;
+          bool               outside = false;
+          for (const unsigned int n : mesh.tets_of_vertex(a_smaller ? a : b))
+            if (tet_mark[n] != affected_stamp)
+            {
+              const mesh::Tet &q = mesh.tet(n);
+              if (q[0] == other || q[1] == other || q[2] == other || q[3] == other)
+              {
+                outside = true;
+                break;
+              }
+            }
+          if (!outside)
+            continue;
           around.clear();
-          mesh.tets_around_edge(edges[e][0], edges[e][1], around);
+          mesh.tets_around_edge(a, b, around);
           for (const unsigned int n : around)
             if (tet_mark[n] != affected_stamp)
               missing.push_back(n);
