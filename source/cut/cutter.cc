@@ -49,6 +49,23 @@ namespace lacerta::cut
       return 0;
     }
 
+    /// The local edges of face f's sides (face vertex k to k + 1): a table, since the
+    /// analysis looks them up for every face of the affected cells.
+    constexpr std::array<std::array<unsigned int, 3>, 4>
+    make_face_edges()
+    {
+      std::array<std::array<unsigned int, 3>, 4> edges{};
+      for (unsigned int f = 0; f < 4; ++f)
+        for (unsigned int k = 0; k < 3; ++k)
+        {
+          const auto &fv = mesh::TetMesh::face_vertices[f];
+          edges[f][k] =
+            static_cast<unsigned int>(tet_edge_of_vertices[fv[k]][fv[(k + 1) % 3]]);
+        }
+      return edges;
+    }
+    constexpr std::array<std::array<unsigned int, 3>, 4> face_edges = make_face_edges();
+
     /// Barycentric coordinates of the rest point @p rest in cell @p t of @p mesh:
     /// the weights that carry it, with the cell's affine map, to the deformed state.
     std::array<double, 4>
@@ -515,10 +532,10 @@ namespace lacerta::cut
       for (unsigned int f = 0; f < 4; ++f)
       {
         const FaceScratch &fs = face_scratch[4 * t + f];
-        if (fs.has_front)
+        if (fs.has_front())
         {
           c.front_faces |= std::uint8_t(1u << f);
-          c.front_points[f] = fs.rest;
+          c.front_points[f] = front_rest[fs.front];
           touched           = true;
         }
       }
@@ -619,11 +636,15 @@ namespace lacerta::cut
     // corner line (the line may run through a mesh face) leaves thin cells there:
     // they are accepted down to 1e-8, still a hundred times above what
     // check_invariants() calls flat, rather than postponing the new side forever.
-    const double flat_volume    = catching_up || after_corner ? 1e-8 : 1e-6;
-    double       longest_parent = 0;
+    const double flat_volume = catching_up || after_corner ? 1e-8 : 1e-6;
+    // One square root (the root is monotone: the same value as the longest norm).
+    double longest_squared = 0;
     for (const auto &e : tet_edge_vertices)
-      longest_parent =
-        std::max(longest_parent, norm(sub(cut.points[e[1]], cut.points[e[0]])));
+    {
+      const Point d   = sub(cut.points[e[1]], cut.points[e[0]]);
+      longest_squared = std::max(longest_squared, dot(d, d));
+    }
+    const double longest_parent = std::sqrt(longest_squared);
     for (unsigned int i = 0; i < result.n_children; ++i)
     {
       const auto p = child_node_points(cut, result, result.children[i]);
@@ -643,7 +664,8 @@ namespace lacerta::cut
     face_scratch.resize(4 * std::size_t(mesh.n_tets()));
     tet_mark.resize(mesh.n_tets(), 0);
     partial_child.resize(mesh.n_tets(), 0);
-    on_surface.resize(mesh.n_vertices(), 0);
+    if (on_surface.size() < mesh.n_vertices())
+      on_surface.resize(mesh.n_vertices(), 0);
     swept.resize(mesh.n_vertices(), 0);
     crossing_pending.resize(mesh.n_vertices(), 0);
   }
@@ -655,7 +677,18 @@ namespace lacerta::cut
     VertexScratch &s = vertex_scratch[v];
     if (s.stamp == analysis_stamp)
       return s;
-    s.stamp       = analysis_stamp;
+    s.stamp  = analysis_stamp;
+    s.parent = v;
+    // Each pass of the analysis starts from the sweep's own judgement (the snapping
+    // and the patches of a pass change on_plane and reached), which depends on the
+    // sweep only: it is computed in the first pass that meets the vertex.
+    if (s.sweep_stamp == affected_stamp)
+    {
+      s.on_plane = s.sweep_on_plane;
+      s.reached  = s.sweep_reached;
+      return s;
+    }
+    s.sweep_stamp = affected_stamp;
     const Point x = position(v);
     double      d = surface.distance(x);
     if (std::abs(d) <= 1e-12 * typical_edge)
@@ -700,11 +733,12 @@ namespace lacerta::cut
     // not behind the start of this sweep by more than a cell (the plane must not
     // reach back along an older part of the crack), or when an earlier sweep of the
     // stroke swept it.
-    s.reached = on_surface[v]
-                  ? surface.behind(at) < 0
-                  : (surface.behind(x) < 0 && surface.ahead_of_start(x) >= -start_reach)
+    s.reached        = on_surface[v]
+                         ? surface.behind(at) < 0
+                         : (surface.behind(x) < 0 && surface.ahead_of_start(x) >= -start_reach)
                       || swept[v] == stroke;
-    s.parent  = v;
+    s.sweep_on_plane = s.on_plane;
+    s.sweep_reached  = s.reached;
     return s;
   }
 
@@ -718,6 +752,7 @@ namespace lacerta::cut
       ++analysis_stamp;
       verts.clear();
       edge_list.clear();
+      front_rest.clear();
       for (const unsigned int t : affected)
       {
         const mesh::Tet &tet = mesh.tet(t);
@@ -851,29 +886,65 @@ namespace lacerta::cut
       }
       // Front points, once per face, from the face's two section corners.
       for (const unsigned int t : affected)
+      {
+        // A front point lies between a reached and an unreached corner (a vertex on
+        // the plane or a crossing): a cell without both, as most cells behind the
+        // front, has none on any face.
+        bool any_reached = false, any_unreached = false;
+        for (const unsigned int v : mesh.tet(t))
+          if (vertex_scratch[v].on_plane)
+            (vertex_scratch[v].reached ? any_reached : any_unreached) = true;
+        for (const unsigned int e : mesh.tet_edges(t))
+          if (edge_scratch[e].crossing)
+            (edge_scratch[e].reached ? any_reached : any_unreached) = true;
         for (unsigned int f = 0; f < 4; ++f)
         {
           FaceScratch &fs = face_scratch[4 * t + f];
           if (fs.stamp == analysis_stamp)
             continue;
-          fs.stamp     = analysis_stamp;
-          fs.has_front = false;
-          compute_front_point(t, f, surface, fs);
+          fs.stamp = analysis_stamp;
+          fs.front = FaceScratch().front;
+          if (any_reached && any_unreached)
+            compute_front_point(t, f, surface, fs);
           // The face seen from the neighbour gets the same front point.
           const unsigned int n = mesh.neighbor(t, f);
           if (n != mesh::invalid_index)
             for (unsigned int g = 0; g < 4; ++g)
               if (mesh.neighbor(n, g) == t)
-                face_scratch[4 * n + g] = fs;
+              {
+                face_scratch[4 * n + g].stamp = fs.stamp;
+                face_scratch[4 * n + g].front = fs.front;
+              }
         }
+      }
       // Closure: everything that must be split alike has to be in the set.
       missing.clear();
       ++star_stamp;
       for (const unsigned int e : edge_list)
         if (edge_scratch[e].reached)
         {
+          // Usually every cell around the edge is in the set already: the smaller
+          // star of the two ends tells, testing the nodes of outside cells only.
+          // Otherwise the cells are listed in the mesh's order, as before.
+          const unsigned int a = edges[e][0], b = edges[e][1];
+          const bool         a_smaller =
+            mesh.tets_of_vertex(a).size() <= mesh.tets_of_vertex(b).size();
+          const unsigned int other   = a_smaller ? b : a;
+          bool               outside = false;
+          for (const unsigned int n : mesh.tets_of_vertex(a_smaller ? a : b))
+            if (tet_mark[n] != affected_stamp)
+            {
+              const mesh::Tet &q = mesh.tet(n);
+              if (q[0] == other || q[1] == other || q[2] == other || q[3] == other)
+              {
+                outside = true;
+                break;
+              }
+            }
+          if (!outside)
+            continue;
           around.clear();
-          mesh.tets_around_edge(edges[e][0], edges[e][1], around);
+          mesh.tets_around_edge(a, b, around);
           for (const unsigned int n : around)
             if (tet_mark[n] != affected_stamp)
               missing.push_back(n);
@@ -906,7 +977,7 @@ namespace lacerta::cut
               missing.push_back(n);
       for (const unsigned int t : affected)
         for (unsigned int f = 0; f < 4; ++f)
-          if (face_scratch[4 * t + f].has_front)
+          if (face_scratch[4 * t + f].has_front())
           {
             const unsigned int n = mesh.neighbor(t, f);
             if (n != mesh::invalid_index && tet_mark[n] != affected_stamp)
@@ -932,7 +1003,7 @@ namespace lacerta::cut
       if (edge_scratch[e].reached)
         return true;
     for (unsigned int f = 0; f < 4; ++f)
-      if (face_scratch[4 * t + f].has_front)
+      if (face_scratch[4 * t + f].has_front())
         return true;
     return false;
   }
@@ -947,22 +1018,25 @@ namespace lacerta::cut
     const mesh::Tet                  &tet = mesh.tet(t);
     const auto                       &fv  = mesh::TetMesh::face_vertices[f];
     const std::array<unsigned int, 3> v{{tet[fv[0]], tet[fv[1]], tet[fv[2]]}};
+    const auto                       &edge_ids = mesh.tet_edges(t);
     // Most faces have no front point: front_point_on_face() wants a segment (two
     // corners) between a reached and an unreached corner, not two vertex corners.
     // Counting the corners first spares those faces the interpolations.
     {
       unsigned int n = 0, n_vertex = 0, n_reached = 0;
       for (unsigned int k = 0; k < 3; ++k)
-        if (vertex_scratch[v[k]].on_plane)
+      {
+        const VertexScratch &vs = vertex_scratch[v[k]];
+        if (vs.on_plane)
         {
           ++n;
           ++n_vertex;
-          n_reached += vertex_scratch[v[k]].reached ? 1 : 0;
+          n_reached += vs.reached ? 1 : 0;
         }
+      }
       for (unsigned int k = 0; k < 3 && n < 3; ++k)
       {
-        const EdgeScratch &es =
-          edge_scratch[mesh.tet_edges(t)[tet_edge_of_vertices[fv[k]][fv[(k + 1) % 3]]]];
+        const EdgeScratch &es = edge_scratch[edge_ids[face_edges[f][k]]];
         if (es.crossing)
         {
           ++n;
@@ -984,11 +1058,9 @@ namespace lacerta::cut
       }
     for (unsigned int k = 0; k < 3 && n_corners < 3; ++k)
     {
-      const unsigned int a = std::min(v[k], v[(k + 1) % 3]),
-                         b = std::max(v[k], v[(k + 1) % 3]);
-      // The edge's id: the local edge of t joining the two local vertices.
-      const int          local = tet_edge_of_vertices[fv[k]][fv[(k + 1) % 3]];
-      const EdgeScratch &es    = edge_scratch[mesh.tet_edges(t)[local]];
+      const unsigned int a  = std::min(v[k], v[(k + 1) % 3]),
+                         b  = std::max(v[k], v[(k + 1) % 3]);
+      const EdgeScratch &es = edge_scratch[edge_ids[face_edges[f][k]]];
       if (!es.crossing)
         continue;
       corners[n_corners++] = {lerp(mesh.vertex(a), mesh.vertex(b), es.t),
@@ -1005,9 +1077,8 @@ namespace lacerta::cut
           rest,
           now))
     {
-      fs.has_front = true;
-      fs.rest      = rest;
-      fs.now       = now;
+      fs.front = static_cast<unsigned int>(front_rest.size());
+      front_rest.push_back(rest);
     }
   }
 
@@ -1119,7 +1190,9 @@ namespace lacerta::cut
                 es.point       = {
                         {mesh::invalid_index, mesh::invalid_index, mesh::invalid_index}};
               }
-              slot = &es.point[point_key(c.vertex_ids, n, parent).side + 1];
+              // The side of the copy this child uses (point_key()'s side of an edge
+              // point).
+              slot = &es.point[n.side + 1];
               break;
             }
             case NodeKind::face_point:
@@ -1379,10 +1452,14 @@ namespace lacerta::cut
   void
   Cutter::mark_on_surface(const unsigned int v)
   {
-    on_surface.resize(mesh.n_vertices(), 0);
+    // Grown by a few hundred entries at a time: the children of a sweep mark their
+    // new particles one by one (entries past the mesh's vertices stay 0).
+    if (v >= on_surface.size())
+      on_surface.resize(std::size_t(mesh.n_vertices()) + 256, 0);
     if (!on_surface[v])
     {
-      joined_at.resize(mesh.n_vertices());
+      if (v >= joined_at.size())
+        joined_at.resize(std::size_t(mesh.n_vertices()) + 256);
       joined_at[v]  = position(v);
       on_surface[v] = 1;
       on_surface_list.push_back(v);
