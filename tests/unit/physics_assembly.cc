@@ -47,20 +47,30 @@ TEST(Assembly, EachTetrahedronGivesItsVerticesItsOwnMass)
 
 TEST(Assembly, ConstantDensityShortcutGivesTheSameMassesToTheLastBit)
 {
-  // The cutter's shortcut for a constant density must not change any mass: the same
-  // quadrature sums, bit for bit, on every cell of a distorted mesh.
+  // The cutter's shortcuts for a constant density and Young's modulus must not change
+  // any mass or stiffness: the same quadrature sums and products, bit for bit, on
+  // every cell of a distorted mesh.
   const mesh::TetMesh mesh =
     test_support::distorted_box(3, 0.25, dealii::Point<3>(1.0, 2.0, 0.5));
-  const dealii::Functions::ConstantFunction<3> density(1234.5);
+  const dealii::Functions::ConstantFunction<3> density(1234.5), youngs(4.7e4);
   const auto                                   sigma = physics::constant_value(density);
   ASSERT_TRUE(sigma.has_value());
   EXPECT_EQ(*sigma, 1234.5);
+  const auto modulus = physics::constant_value(youngs);
+  ASSERT_TRUE(modulus.has_value());
   for (unsigned int t = 0; t < mesh.n_tets(); ++t)
   {
     const auto by_function = physics::tet_mass_contributions(mesh, t, density);
     const auto by_value    = physics::tet_mass_contributions(mesh, t, *sigma);
+    const auto by_volume =
+      physics::constant_density_mass_contributions(mesh.volume(t), *sigma);
     for (unsigned int i = 0; i < 4; ++i)
+    {
       EXPECT_EQ(by_function[i], by_value[i]) << "tet " << t << " vertex " << i;
+      EXPECT_EQ(by_function[i], by_volume[i]) << "tet " << t << " vertex " << i;
+    }
+    EXPECT_EQ(physics::tet_stiffness_factor(mesh, t, youngs), *modulus * mesh.volume(t))
+      << "tet " << t;
   }
   EXPECT_EQ(physics::constant_value(dealii::Functions::ZeroFunction<3>()), 0.0);
   // Functions that are not known to be constant are evaluated point by point.
