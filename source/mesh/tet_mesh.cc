@@ -704,24 +704,22 @@ namespace lacerta::mesh
       }
     }
 
-    // Put the new tets in.
+    // Put the new tets in: the first ones into the removed ones' slots, the others
+    // appended (the arrays grow once, not once per tet).
     added_ids.resize(added.size());
+    const std::size_t n_old = tets.size(), n_new = n_old + added.size() - removed.size();
+    tets.resize(n_new);
+    tet_edge_ids.resize(n_new);
+    neighbors.resize(4 * n_new, invalid_index);
+    boundary_slot.resize(4 * n_new, invalid_index);
     for (std::size_t k = 0; k < added.size(); ++k)
     {
-      unsigned int slot;
-      if (k < removed.size())
-        slot = removed[k];
-      else
-      {
-        slot = static_cast<unsigned int>(tets.size());
-        tets.emplace_back();
-        tet_edge_ids.emplace_back();
-        neighbors.insert(neighbors.end(), 4, invalid_index);
-        boundary_slot.insert(boundary_slot.end(), 4, invalid_index);
-      }
-      added_ids[k]       = slot;
-      tets[slot]         = added[k];
-      tet_edge_ids[slot] = new_edge_ids[k];
+      const unsigned int slot = k < removed.size()
+                                  ? removed[k]
+                                  : static_cast<unsigned int>(n_old + k - removed.size());
+      added_ids[k]            = slot;
+      tets[slot]              = added[k];
+      tet_edge_ids[slot]      = new_edge_ids[k];
       for (const unsigned int v : added[k])
       {
         vertex_tets[v].push_back(slot);
