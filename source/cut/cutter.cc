@@ -152,7 +152,8 @@ namespace lacerta::cut
                      lengths.end());
     typical_edge = lengths[lengths.size() / 2];
     tree.build(mesh, system.position.data());
-    constant_density = physics::constant_value(density);
+    constant_density        = physics::constant_value(density);
+    constant_youngs_modulus = physics::constant_value(youngs_modulus);
     tet_stamp.assign(mesh.n_tets(), 0);
     edge_stamp.assign(mesh.n_edges(), 0);
     on_surface.assign(mesh.n_vertices(), 0);
@@ -1093,24 +1094,38 @@ namespace lacerta::cut
     physics::SpringSet &springs = system.springs;
     touched_vertices.clear();
     double integral_delta = 0;
-    // A constant density (the common case) needs no Function call per quadrature
-    // point; the masses are the same to the last bit.
-    const auto mass_contributions = [&](const unsigned int t)
+    // A constant density and Young's modulus (the common case) need no Function call
+    // and one volume per cell instead of two; the masses and stiffness factors are the
+    // same to the last bit.
+    struct CellTerms
     {
-      return constant_density
-               ? physics::tet_mass_contributions(mesh, t, *constant_density)
-               : physics::tet_mass_contributions(mesh, t, density);
+      std::array<double, 4> mass;
+      double                stiffness_factor;
+    };
+    const auto cell_terms = [&](const unsigned int t) -> CellTerms
+    {
+      if (constant_density && constant_youngs_modulus)
+      {
+        const double volume = mesh.volume(t);
+        return {physics::constant_density_mass_contributions(volume, *constant_density),
+                *constant_youngs_modulus * volume};
+      }
+      return {constant_density
+                ? physics::tet_mass_contributions(mesh, t, *constant_density)
+                : physics::tet_mass_contributions(mesh, t, density),
+              physics::tet_stiffness_factor(mesh, t, youngs_modulus)};
     };
     for (const unsigned int r : removed)
     {
-      const auto m = mass_contributions(r);
+      const CellTerms              terms = cell_terms(r);
+      const std::array<double, 4> &m     = terms.mass;
       for (unsigned int i = 0; i < 4; ++i)
       {
         system.mass[mesh.tet(r)[i]] -= m[i];
         touched_vertices.push_back(mesh.tet(r)[i]);
         integral_delta -= m[i];
       }
-      const double f = -physics::tet_stiffness_factor(mesh, r, youngs_modulus);
+      const double f = -terms.stiffness_factor;
       for (const unsigned int e : mesh.tet_edges(r))
         springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
     }
@@ -1370,15 +1385,16 @@ namespace lacerta::cut
     prepare_scratch();
     for (std::size_t k = 0; k < added_ids.size(); ++k)
     {
-      const unsigned int t = added_ids[k];
-      const auto         m = mass_contributions(t);
+      const unsigned int           t     = added_ids[k];
+      const CellTerms              terms = cell_terms(t);
+      const std::array<double, 4> &m     = terms.mass;
       for (unsigned int i = 0; i < 4; ++i)
       {
         system.mass[mesh.tet(t)[i]] += m[i];
         touched_vertices.push_back(mesh.tet(t)[i]);
         integral_delta += m[i];
       }
-      const double f = physics::tet_stiffness_factor(mesh, t, youngs_modulus);
+      const double f = terms.stiffness_factor;
       for (const unsigned int e : mesh.tet_edges(t))
         springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
       for (unsigned int f2 = 0; f2 < 4; ++f2)

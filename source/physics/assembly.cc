@@ -86,12 +86,18 @@ namespace lacerta::physics
                          const unsigned int   t,
                          const double         sigma)
   {
-    // The same sums in the same order as above with σ(x) = sigma, so that the
-    // contributions are bit-identical; only the quadrature points and the calls of
-    // the density are saved.
+    return constant_density_mass_contributions(mesh.volume(t), sigma);
+  }
+
+
+  std::array<double, 4>
+  constant_density_mass_contributions(const double volume, const double sigma)
+  {
+    // The same sums in the same order as the general tet_mass_contributions() with
+    // σ(x) = sigma, so that the contributions are bit-identical; only the quadrature
+    // points and the calls of the density are saved.
     static const BarycentricRule rule;
-    std::array<double, 4>        m      = {{0, 0, 0, 0}};
-    const double                 volume = mesh.volume(t);
+    std::array<double, 4>        m = {{0, 0, 0, 0}};
     for (unsigned int q = 0; q < rule.weights.size(); ++q)
     {
       const double jxw = rule.weights[q] * volume;

@@ -22,6 +22,26 @@ namespace lacerta::scene
       }
       return values;
     }
+
+
+    /**
+     * The scalar field @p expression of entry @p entry. A plain number (digits, sign,
+     * point, exponent: no variable can appear) becomes a ConstantFunction, which the
+     * cut update recognises (physics::constant_value()) to compute masses and
+     * stiffnesses without a Function call per point. Its value is the parser's own,
+     * so no mass or stiffness changes.
+     */
+    std::unique_ptr<dealii::Function<3>>
+    parse_field(const std::string                   &entry,
+                const std::string                   &expression,
+                const std::map<std::string, double> &constants)
+    {
+      auto parser = parse_function(entry, expression, 1, false, constants);
+      if (expression.find_first_not_of("0123456789.eE+- \t") == std::string::npos)
+        return std::make_unique<dealii::Functions::ConstantFunction<3>>(
+          parser->value(dealii::Point<3>()));
+      return parser;
+    }
   } // namespace
 
 
@@ -86,21 +106,10 @@ namespace lacerta::scene
   Material::parse_parameters(dealii::ParameterHandler &prm)
   {
     prm.enter_subsection("Material");
-    const auto        constants = parse_constants(prm.get("Function constants"));
-    const std::string density   = prm.get("Density");
-    auto              density_parser =
-      parse_function("Material/Density", density, 1, false, constants);
-    // A plain number (digits, sign, point, exponent: no variable can appear) becomes
-    // a ConstantFunction, which the cut update recognises (physics::constant_value())
-    // to compute masses without a Function call per quadrature point. Its value is
-    // the parser's own, so no mass changes.
-    if (density.find_first_not_of("0123456789.eE+- \t") == std::string::npos)
-      density_function = std::make_unique<dealii::Functions::ConstantFunction<3>>(
-        density_parser->value(dealii::Point<3>()));
-    else
-      density_function = std::move(density_parser);
-    youngs_function = parse_function(
-      "Material/Youngs modulus", prm.get("Youngs modulus"), 1, false, constants);
+    const auto constants = parse_constants(prm.get("Function constants"));
+    density_function     = parse_field("Material/Density", prm.get("Density"), constants);
+    youngs_function =
+      parse_field("Material/Youngs modulus", prm.get("Youngs modulus"), constants);
     elongation_function = parse_function(
       "Material/Maximum elongation", prm.get("Maximum elongation"), 1, false, constants);
     poisson_ratio  = prm.get_double("Poisson ratio");

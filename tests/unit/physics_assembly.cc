@@ -47,20 +47,30 @@ TEST(Assembly, EachTetrahedronGivesItsVerticesItsOwnMass)
 
 TEST(Assembly, ConstantDensityShortcutGivesTheSameMassesToTheLastBit)
 {
-  // The cutter's shortcut for a constant density must not change any mass: the same
-  // quadrature sums, bit for bit, on every cell of a distorted mesh.
+  // The cutter's shortcuts for a constant density and Young's modulus must not change
+  // any mass or stiffness: the same quadrature sums and products, bit for bit, on
+  // every cell of a distorted mesh.
   const mesh::TetMesh mesh =
     test_support::distorted_box(3, 0.25, dealii::Point<3>(1.0, 2.0, 0.5));
-  const dealii::Functions::ConstantFunction<3> density(1234.5);
+  const dealii::Functions::ConstantFunction<3> density(1234.5), youngs(4.7e4);
   const auto                                   sigma = physics::constant_value(density);
   ASSERT_TRUE(sigma.has_value());
   EXPECT_EQ(*sigma, 1234.5);
+  const auto modulus = physics::constant_value(youngs);
+  ASSERT_TRUE(modulus.has_value());
   for (unsigned int t = 0; t < mesh.n_tets(); ++t)
   {
     const auto by_function = physics::tet_mass_contributions(mesh, t, density);
     const auto by_value    = physics::tet_mass_contributions(mesh, t, *sigma);
+    const auto by_volume =
+      physics::constant_density_mass_contributions(mesh.volume(t), *sigma);
     for (unsigned int i = 0; i < 4; ++i)
+    {
       EXPECT_EQ(by_function[i], by_value[i]) << "tet " << t << " vertex " << i;
+      EXPECT_EQ(by_function[i], by_volume[i]) << "tet " << t << " vertex " << i;
+    }
+    EXPECT_EQ(physics::tet_stiffness_factor(mesh, t, youngs), *modulus * mesh.volume(t))
+      << "tet " << t;
   }
   EXPECT_EQ(physics::constant_value(dealii::Functions::ZeroFunction<3>()), 0.0);
   // Functions that are not known to be constant are evaluated point by point.
@@ -72,35 +82,42 @@ TEST(Assembly, ConstantDensityShortcutGivesTheSameMassesToTheLastBit)
 }
 
 
-TEST(Assembly, NumericDensityIsAConstantFunctionWithTheParsersValue)
+TEST(Assembly, NumericDensityAndModulusAreConstantFunctionsWithTheParsersValue)
 {
-  // A density given as a plain number gets the cut update's constant-density
-  // shortcut, with the value the expression parser gives; an expression of x, y, z
-  // does not.
-  const auto density_of = [](const std::string &expression)
+  // A density or Young's modulus given as a plain number gets the cut update's
+  // constant shortcut, with the value the expression parser gives; an expression of
+  // x, y, z does not.
+  const auto material_with = [](const std::string &entry, const std::string &expression)
   {
     dealii::ParameterHandler prm;
     scene::Material::declare_parameters(prm);
     prm.enter_subsection("Material");
-    prm.set("Density", expression);
+    prm.set(entry, expression);
     prm.leave_subsection();
     scene::Material material;
     material.parse_parameters(prm);
     return material;
   };
-  for (const std::string expression : {"1000", " 1.25e3 ", "0.1", "-2+7"})
+  for (const std::string entry : {"Density", "Youngs modulus"})
   {
-    const scene::Material     material = density_of(expression);
-    dealii::FunctionParser<3> parsed(1);
-    parsed.initialize("x,y,z", expression, {});
-    const auto sigma = physics::constant_value(material.density());
-    ASSERT_TRUE(sigma.has_value()) << expression;
-    EXPECT_EQ(*sigma, parsed.value(dealii::Point<3>())) << expression;
-    EXPECT_EQ(material.density().value(dealii::Point<3>(0.3, -1, 2)), *sigma);
+    const auto field = [&](const scene::Material &material) -> const auto &
+    {
+      return entry == "Density" ? material.density() : material.youngs_modulus();
+    };
+    for (const std::string expression : {"1000", " 1.25e3 ", "0.1", "-2+7"})
+    {
+      const scene::Material     material = material_with(entry, expression);
+      dealii::FunctionParser<3> parsed(1);
+      parsed.initialize("x,y,z", expression, {});
+      const auto value = physics::constant_value(field(material));
+      ASSERT_TRUE(value.has_value()) << entry << " " << expression;
+      EXPECT_EQ(*value, parsed.value(dealii::Point<3>())) << entry << " " << expression;
+      EXPECT_EQ(field(material).value(dealii::Point<3>(0.3, -1, 2)), *value);
+    }
+    const scene::Material varying = material_with(entry, "1000*(1 + x)");
+    EXPECT_FALSE(physics::constant_value(field(varying)).has_value()) << entry;
+    EXPECT_EQ(field(varying).value(dealii::Point<3>(0.5, 0, 0)), 1500.0) << entry;
   }
-  const scene::Material varying = density_of("1000*(1 + x)");
-  EXPECT_FALSE(physics::constant_value(varying.density()).has_value());
-  EXPECT_EQ(varying.density().value(dealii::Point<3>(0.5, 0, 0)), 1500.0);
 }
 
 

@@ -315,6 +315,8 @@ namespace lacerta::cut
     double                            &integral_of_density;
     /// The density's value if it is constant (physics::constant_value()).
     std::optional<double> constant_density;
+    /// Young's modulus if it is constant (physics::constant_value()).
+    std::optional<double> constant_youngs_modulus;
     Parameters            parameters;
     Blade                 current;
     /// The crack front as last applied: the start of the next swept surface.

@@ -59,6 +59,14 @@ namespace lacerta::physics
   tet_mass_contributions(const mesh::TetMesh &mesh, unsigned int t, double sigma);
 
   /**
+   * tet_mass_contributions() for a density that is @p sigma everywhere, of a
+   * tetrahedron whose volume mesh.volume(t) is @p volume: the same values to the last
+   * bit, for a caller that needs the volume for its stiffness too.
+   */
+  std::array<double, 4>
+  constant_density_mass_contributions(double volume, double sigma);
+
+  /**
    * The value of @p f if it is a scalar dealii::Functions::ConstantFunction or
    * ZeroFunction (so that callers can use the constant-density overload), otherwise
    * nothing.

@@ -14,8 +14,8 @@ namespace lacerta::scene
 {
   /**
    * Density σ(x) and Young's modulus E(x) as FunctionParser expressions of x, y, z
-   * (`subsection Material`; a density that is a plain number is a ConstantFunction),
-   * the Poisson ratio for the FEM reference, and damping.
+   * (`subsection Material`; a density or modulus that is a plain number is a
+   * ConstantFunction), the Poisson ratio for the FEM reference, and damping.
    */
   class Material
   {
@@ -64,9 +64,9 @@ namespace lacerta::scene
     double spring_damping = 0;
 
   private:
-    /// A ConstantFunction when the expression is a plain number, else its parser.
+    /// ConstantFunctions when the expressions are plain numbers, else their parsers.
     std::unique_ptr<dealii::Function<3>>       density_function;
-    std::unique_ptr<dealii::FunctionParser<3>> youngs_function;
+    std::unique_ptr<dealii::Function<3>>       youngs_function;
     std::unique_ptr<dealii::FunctionParser<3>> elongation_function;
   };
 } // namespace lacerta::scene
