@@ -904,7 +904,7 @@ namespace lacerta::cut
           if (fs.stamp == analysis_stamp)
             continue;
           fs.stamp = analysis_stamp;
-          fs.front = FaceScratch().front;
+          fs.front = FaceScratch::no_front;
           if (any_reached && any_unreached)
             compute_front_point(t, f, surface, fs);
           // The face seen from the neighbour gets the same front point.
@@ -925,23 +925,17 @@ namespace lacerta::cut
         if (edge_scratch[e].reached)
         {
           // Usually every cell around the edge is in the set already: the smaller
-          // star of the two ends tells, testing the nodes of outside cells only.
-          // Otherwise the cells are listed in the mesh's order, as before.
+          // star of the two ends tells. Otherwise the cells are listed in the mesh's
+          // order, as before.
           const unsigned int a = edges[e][0], b = edges[e][1];
-          const bool         a_smaller =
-            mesh.tets_of_vertex(a).size() <= mesh.tets_of_vertex(b).size();
-          const unsigned int other   = a_smaller ? b : a;
           bool               outside = false;
-          for (const unsigned int n : mesh.tets_of_vertex(a_smaller ? a : b))
-            if (tet_mark[n] != affected_stamp)
-            {
-              const mesh::Tet &q = mesh.tet(n);
-              if (q[0] == other || q[1] == other || q[2] == other || q[3] == other)
-              {
-                outside = true;
-                break;
-              }
-            }
+          mesh.visit_tets_with_edge(a,
+                                    b,
+                                    [&](const unsigned int n, unsigned int)
+                                    {
+                                      outside = tet_mark[n] != affected_stamp;
+                                      return outside;
+                                    });
           if (!outside)
             continue;
           around.clear();

@@ -463,71 +463,17 @@ namespace lacerta::mesh
   }
 
 
-  namespace
-  {
-    /**
-     * Calls @p visit (t, e) for the tetrahedra t of @p tets that hold both @p a and
-     * @p b, found through the stars @p vertex_tets, with e the local edge joining
-     * them, until it returns true.
-     */
-    template <typename Visit>
-    void
-    visit_edge_cells(const std::vector<std::vector<unsigned int>> &vertex_tets,
-                     const std::vector<Tet>                       &tets,
-                     const unsigned int                            a,
-                     const unsigned int                            b,
-                     Visit                                       &&visit)
-    {
-      // Any tetrahedron with both ends has the edge: search the smaller star (a vertex
-      // just made by a cut has an empty one). A cell of u's star has u, so it has the
-      // edge if it also has w: four comparisons instead of two for each of six edges
-      // (the searches for retired edges in replace_tets() go through the whole star).
-      const bool         from_a = vertex_tets[a].size() <= vertex_tets[b].size();
-      const unsigned int u = from_a ? a : b, w = from_a ? b : a;
-      for (const unsigned int t : vertex_tets[u])
-      {
-        const Tet   &q = tets[t];
-        unsigned int j = 0;
-        while (j < 4 && q[j] != w)
-          ++j;
-        if (j == 4)
-          continue;
-        unsigned int i = 0;
-        while (q[i] != u)
-          ++i;
-        if (i > j)
-          std::swap(i, j);
-        static_assert(
-          []
-          {
-            for (unsigned int e = 0; e < 6; ++e)
-              if (TetMesh::edge_vertices[e][0] + TetMesh::edge_vertices[e][1]
-                    - (TetMesh::edge_vertices[e][0] == 0 ? 1 : 0)
-                  != e)
-                return false;
-            return true;
-          }(),
-          "local edge (i, j) is numbered i + j - [i == 0]");
-        if (visit(t, i + j - (i == 0 ? 1 : 0)))
-          return;
-      }
-    }
-  } // namespace
-
-
   unsigned int
   TetMesh::find_edge(const unsigned int a, const unsigned int b) const
   {
     unsigned int id = invalid_index;
-    visit_edge_cells(vertex_tets,
-                     tets,
-                     a,
-                     b,
-                     [&](const unsigned int t, const unsigned int e)
-                     {
-                       id = tet_edge_ids[t][e];
-                       return true;
-                     });
+    visit_tets_with_edge(a,
+                         b,
+                         [&](const unsigned int t, const unsigned int e)
+                         {
+                           id = tet_edge_ids[t][e];
+                           return true;
+                         });
     return id;
   }
 
@@ -784,15 +730,13 @@ namespace lacerta::mesh
       {
         edges[r] = edges[last];
         // Every cell with both ends holds the moved edge, at one local edge.
-        visit_edge_cells(vertex_tets,
-                         tets,
-                         edges[r][0],
-                         edges[r][1],
-                         [&](const unsigned int t, const unsigned int e)
-                         {
-                           tet_edge_ids[t][e] = r;
-                           return false;
-                         });
+        visit_tets_with_edge(edges[r][0],
+                             edges[r][1],
+                             [&](const unsigned int t, const unsigned int e)
+                             {
+                               tet_edge_ids[t][e] = r;
+                               return false;
+                             });
       }
       update.moves.push_back({{r, last}});
       edges.pop_back();

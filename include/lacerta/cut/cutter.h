@@ -227,14 +227,16 @@ namespace lacerta::cut
     /// analysis visits every face of the affected cells and few have a front point.
     struct FaceScratch
     {
-      unsigned int stamp = 0, point_stamp = 0, point = 0,
-                   front = std::numeric_limits<unsigned int>::max();
+      /// `front` of a face without a front point.
+      static constexpr unsigned int no_front = std::numeric_limits<unsigned int>::max();
+
+      unsigned int stamp = 0, point_stamp = 0, point = 0, front = no_front;
 
       /// Whether the face has a front point in this pass of the analysis.
       bool
       has_front() const
       {
-        return front != std::numeric_limits<unsigned int>::max();
+        return front != no_front;
       }
     };
 

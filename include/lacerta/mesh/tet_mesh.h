@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace lacerta::mesh
@@ -234,6 +235,49 @@ namespace lacerta::mesh
     /// The id of the edge joining @p a and @p b, or invalid_index (needs local updates).
     unsigned int
     find_edge(unsigned int a, unsigned int b) const;
+
+    /**
+     * Calls @p visit (t, e) for the tetrahedra t that hold both @p a and @p b, with e
+     * the local edge joining them, until it returns true (needs local updates). The
+     * cells come in the order of the smaller of the two stars.
+     */
+    template <typename Visit>
+    void
+    visit_tets_with_edge(const unsigned int a, const unsigned int b, Visit &&visit) const
+    {
+      // Any tetrahedron with both ends has the edge: search the smaller star (a vertex
+      // just made by a cut has an empty one). A cell of u's star has u, so it has the
+      // edge if it also has w: four comparisons instead of two for each of six edges.
+      const bool         from_a = vertex_tets[a].size() <= vertex_tets[b].size();
+      const unsigned int u = from_a ? a : b, w = from_a ? b : a;
+      for (const unsigned int t : vertex_tets[u])
+      {
+        const Tet   &q = tets[t];
+        unsigned int j = 0;
+        while (j < 4 && q[j] != w)
+          ++j;
+        if (j == 4)
+          continue;
+        unsigned int i = 0;
+        while (q[i] != u)
+          ++i;
+        if (i > j)
+          std::swap(i, j);
+        static_assert(
+          []
+          {
+            for (unsigned int e = 0; e < 6; ++e)
+              if (edge_vertices[e][0] + edge_vertices[e][1]
+                    - (edge_vertices[e][0] == 0 ? 1 : 0)
+                  != e)
+                return false;
+            return true;
+          }(),
+          "local edge (i, j) is numbered i + j - [i == 0]");
+        if (visit(t, i + j - (i == 0 ? 1 : 0)))
+          return;
+      }
+    }
 
     /// Appends the tetrahedra containing both @p a and @p b to @p out (local updates).
     void
