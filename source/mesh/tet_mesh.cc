@@ -432,10 +432,10 @@ namespace lacerta::mesh
   {
     if (!vertex_tets.empty())
       return;
-    vertex_tets.assign(vertices.size(), {});
+    vertex_tets.resize(vertices.size());
     for (unsigned int t = 0; t < tets.size(); ++t)
       for (const unsigned int v : tets[t])
-        vertex_tets[v].push_back(t);
+        vertex_tets.insert(v, t);
     boundary_slot.assign(4 * tets.size(), invalid_index);
     for (unsigned int i = 0; i < boundary_faces.size(); ++i)
       boundary_slot[4 * boundary_faces[i].tet + boundary_faces[i].face] = i;
@@ -496,9 +496,7 @@ namespace lacerta::mesh
   TetMesh::add_vertex(const Point3 &x)
   {
     vertices.push_back(x);
-    // Room for a typical star at once (a vertex made by a cut gets its cells one by
-    // one in replace_tets()).
-    vertex_tets.emplace_back().reserve(16);
+    vertex_tets.resize(vertices.size());
     boundary_vertex.push_back(0);
     return static_cast<unsigned int>(vertices.size() - 1);
   }
@@ -634,8 +632,7 @@ namespace lacerta::mesh
       }
       for (const unsigned int v : tets[r])
       {
-        auto &star = vertex_tets[v];
-        star.erase(std::find(star.begin(), star.end(), r));
+        vertex_tets.erase(v, r);
         note_vertex(v);
       }
       for (unsigned int f = 0; f < 4; ++f)
@@ -668,7 +665,7 @@ namespace lacerta::mesh
       tet_edge_ids[slot]      = new_edge_ids[k];
       for (const unsigned int v : added[k])
       {
-        vertex_tets[v].push_back(slot);
+        vertex_tets.insert(v, slot);
         note_vertex(v);
       }
     }
@@ -685,7 +682,7 @@ namespace lacerta::mesh
                              tets[t][face_vertices[f][1]],
                              tets[t][face_vertices[f][2]]};
         for (unsigned int i = 1; i < 3; ++i)
-          if (vertex_tets[v[i]].size() < vertex_tets[v[0]].size())
+          if (vertex_tets.star_size(v[i]) < vertex_tets.star_size(v[0]))
             std::swap(v[0], v[i]);
         unsigned int other = invalid_index, other_face = 0;
         for (const unsigned int s : vertex_tets[v[0]])
@@ -747,9 +744,9 @@ namespace lacerta::mesh
     {
       if (v >= boundary_vertex.size())
         boundary_vertex.resize(v + 1, 0);
-      std::uint8_t on_boundary = 0;
-      for (auto t = vertex_tets[v].begin(); !on_boundary && t != vertex_tets[v].end();
-           ++t)
+      std::uint8_t            on_boundary = 0;
+      const VertexStars::Star star        = vertex_tets[v];
+      for (auto t = star.begin(); !on_boundary && t != star.end(); ++t)
         for (unsigned int f = 0; f < 4; ++f)
           if (neighbors[4 * *t + f] == invalid_index && tets[*t][f] != v)
             on_boundary = 1;

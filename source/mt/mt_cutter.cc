@@ -113,7 +113,7 @@ namespace lacerta::mt
     if (vertex_tets.size() < mt.n_vertices())
       vertex_tets.resize(mt.n_vertices());
     for (const auto v : mt.tets[t])
-      vertex_tets[v].push_back(t);
+      vertex_tets.insert(v, t);
   }
 
 

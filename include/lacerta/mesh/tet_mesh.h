@@ -4,6 +4,8 @@
  */
 #pragma once
 
+#include <lacerta/mesh/vertex_stars.h>
+
 #include <array>
 #include <cstdint>
 #include <string>
@@ -226,7 +228,7 @@ namespace lacerta::mesh
     }
 
     /// The tetrahedra incident to vertex @p v (needs enable_local_updates()).
-    const std::vector<unsigned int> &
+    VertexStars::Star
     tets_of_vertex(const unsigned int v) const
     {
       return vertex_tets[v];
@@ -248,7 +250,7 @@ namespace lacerta::mesh
       // Any tetrahedron with both ends has the edge: search the smaller star (a vertex
       // just made by a cut has an empty one). A cell of u's star has u, so it has the
       // edge if it also has w: four comparisons instead of two for each of six edges.
-      const bool         from_a = vertex_tets[a].size() <= vertex_tets[b].size();
+      const bool         from_a = vertex_tets.star_size(a) <= vertex_tets.star_size(b);
       const unsigned int u = from_a ? a : b, w = from_a ? b : a;
       for (const unsigned int t : vertex_tets[u])
       {
@@ -340,7 +342,7 @@ namespace lacerta::mesh
     add_boundary_face(unsigned int t, unsigned int f, unsigned int id);
 
     /// For local updates: the tetrahedra around every vertex.
-    std::vector<std::vector<unsigned int>> vertex_tets;
+    VertexStars vertex_tets;
     /// For local updates: index into boundary_faces of face 4 t + f, or invalid_index.
     std::vector<unsigned int> boundary_slot;
 

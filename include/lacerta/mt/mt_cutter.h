@@ -7,6 +7,7 @@
 
 #include <lacerta/cut/cut_record.h>
 #include <lacerta/cut/geometry.h>
+#include <lacerta/mesh/vertex_stars.h>
 #include <lacerta/mt/lod.h>
 #include <lacerta/mt/multi_triangulation.h>
 
@@ -135,7 +136,7 @@ namespace lacerta::mt
     std::array<unsigned int, 3>             dims{{1, 1, 1}};
     std::vector<std::vector<std::uint32_t>> cells;
     /// Per vertex: the tets containing it (replaced ones included; filtered on use).
-    std::vector<std::vector<std::uint32_t>> vertex_tets;
+    mesh::VertexStars vertex_tets;
     /// The triangles of earlier cut surfaces near the tetrahedra in which they ended
     /// (the crack closed there), with their normals towards +1: cut again together
     /// with later records whose surface meets them, so that a continuation (a tear
