@@ -61,6 +61,9 @@ namespace lacerta::cut
     nodes.clear();
     for (const auto &bf : mesh.get_boundary_faces())
       faces.push_back(make_face(mesh, bf.tet, bf.face));
+    // The faces added until the next rebuild (refit() rebuilds past 64 + a tenth of
+    // the tree, one cut step later at most): reserved so that a cut copies none.
+    extra.reserve(128 + faces.size() / 5);
     // The vertices of the faces: the boundary vertices, in order.
     vertices.clear();
     for (unsigned int v = 0; v < mesh.n_vertices(); ++v)

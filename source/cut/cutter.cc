@@ -138,6 +138,7 @@ namespace lacerta::cut
     on_surface.reserve(room(mesh.n_vertices()));
     joined_at.reserve(room(mesh.n_vertices()));
     swept.reserve(room(mesh.n_vertices()));
+    crossing_pending.reserve(room(mesh.n_vertices()));
     edge_scratch.reserve(room(mesh.n_edges()));
     edge_stamp.reserve(room(mesh.n_edges()));
     face_scratch.reserve(4 * room(mesh.n_tets()));
