@@ -697,10 +697,12 @@ namespace lacerta::mesh
         {
           if (s == t)
             continue;
-          const Tet &q   = tets[s];
-          const auto has = [&](unsigned int w)
-          { return q[0] == w || q[1] == w || q[2] == w || q[3] == w; };
-          if (has(v[1]) && has(v[2]))
+          const Tet &q = tets[s];
+          // Without short-circuits: most cells of the star lack v[1] or v[2], at
+          // positions no branch predictor learns.
+          const auto has = [&](const unsigned int w)
+          { return (q[0] == w) | (q[1] == w) | (q[2] == w) | (q[3] == w); };
+          if (has(v[1]) & has(v[2]))
           {
             other = s;
             for (unsigned int g = 0; g < 4; ++g)
