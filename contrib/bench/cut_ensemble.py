@@ -13,7 +13,8 @@ with it rests on rounding ties (doc/cutting.md, "Limits"). Usage:
 
 Run k shifts every keyframe's tail and head by k*delta along x (runs 1-4), -x (5-9,
 with 1e-13 along y as well), and so on; run 0 is the scene unchanged. Each run is the
-scene in test mode with the statistics postprocessor only, in a temporary directory.
+scene in test mode with the statistics postprocessor only, in a temporary directory (--keep DIR
+keeps the parameter files, run<k>.prm, to rerun one).
 A piece is "major" if it holds at least --major of the total rest volume; the others
 are fragments. Needs python3 only.
 """
@@ -72,6 +73,8 @@ def main():
     parser.add_argument("--end-time", type=float, help="override the scene's End time")
     parser.add_argument("--major", type=float, default=0.01,
                         help="volume fraction from which a piece is major (default 0.01)")
+    parser.add_argument("--keep", metavar="DIR",
+                        help="write the runs' parameter files and output into DIR and keep them")
     parser.add_argument("--jobs", type=int, default=1, help="runs at once (default 1)")
     parser.add_argument("--set", action="append", default=[],
                         help="an extra setting 'Subsection/Entry=value' (repeatable)")
@@ -83,7 +86,10 @@ def main():
     lacerta = os.path.abspath(args.lacerta)
     frames = read_keyframes(scene)
     outcomes = {}
-    with tempfile.TemporaryDirectory(prefix="cut_ensemble") as work:
+    if args.keep:
+        os.makedirs(args.keep, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="cut_ensemble") as scratch:
+        work = os.path.abspath(args.keep) if args.keep else scratch
         prms = []
         for run in range(args.runs):
             dx, dy = shift(run, args.delta)
