@@ -375,6 +375,10 @@ namespace lacerta::cut
     /// Stroke in which a tetrahedron was made by a partial split (not split partially
     /// again while the front is inside it).
     std::vector<unsigned int> partial_child;
+    /// The edges (their ends) that the last applied sweep's plane crossed ahead of its
+    /// front, where the crack tip waits, and their ids in the current sweep (sorted).
+    std::vector<std::array<unsigned int, 2>> front_edges;
+    std::vector<unsigned int>                front_edge_ids;
 
     // Scratch, kept between sweeps so that no sweep allocates or clears O(mesh).
     std::vector<VertexScratch> vertex_scratch;
