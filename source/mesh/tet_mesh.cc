@@ -557,11 +557,12 @@ namespace lacerta::mesh
     // cells appears in several of them) without searching a star again.
     auto &new_edge_ids = scratch.new_edge_ids;
     new_edge_ids.resize(added.size());
-    // The new cells have about 1.5 distinct edges each: a table of 4-8 slots per cell
-    // stays under 40 % full and, cleared at every update, evicts less from the cache
-    // than a larger one.
+    // The new cells have about 1.5 distinct edges each, but a few cells apart from
+    // each other have up to six: the table has room for six per cell (8 slots per
+    // cell, so it never fills and the probing always ends), and, cleared at every
+    // update, evicts little from the cache.
     std::size_t table_size = 16;
-    while (table_size < 4 * added.size())
+    while (table_size < 8 * added.size())
       table_size *= 2;
     auto &created = scratch.created;
     created.assign(table_size, {{invalid_index, invalid_index, invalid_index}});

@@ -134,3 +134,42 @@ TEST(TetMesh, SpatialSortKeepsGeometryAndBoundaryIds)
   EXPECT_EQ(tagged, 1u);
   EXPECT_EQ(mesh.n_vertices(), 6u); // unused input vertices are dropped
 }
+
+
+TEST(TetMesh, ReplacingCellsApartFromEachOtherKeepsTheirEdges)
+{
+  // Four tetrahedra without a common vertex: 24 distinct edges among four cells, more
+  // than the 1.5 per cell of a cut (the edge table of replace_tets() once had 16
+  // slots here and never finished).
+  std::vector<Point3> vertices;
+  std::vector<Tet>    cells;
+  for (unsigned int k = 0; k < 4; ++k)
+  {
+    const double       x = 2.0 * k;
+    const unsigned int v = static_cast<unsigned int>(vertices.size());
+    vertices.insert(vertices.end(), {{x, 0, 0}, {x + 1, 0, 0}, {x, 1, 0}, {x, 0, 1}});
+    cells.push_back({v, v + 1, v + 2, v + 3});
+  }
+  TetMesh mesh(vertices, cells, "four apart");
+  mesh.enable_local_updates();
+  const unsigned int                       n_edges = mesh.n_edges();
+  std::vector<std::array<unsigned int, 6>> edges_before;
+  for (unsigned int t = 0; t < 4; ++t)
+    edges_before.push_back(mesh.tet_edges(t));
+  std::vector<unsigned int>                ids;
+  TetMesh::EdgeUpdate                      update;
+  std::vector<std::array<unsigned int, 4>> face_ids(4, {{1, 1, 1, 1}});
+  std::vector<Tet>                         added;
+  for (unsigned int t = 0; t < 4; ++t)
+    added.push_back(mesh.tet(t));
+  mesh.replace_tets({0, 1, 2, 3}, added, face_ids, ids, update);
+  EXPECT_EQ(mesh.n_edges(), n_edges);
+  EXPECT_EQ(update.n_added, 0u);
+  EXPECT_TRUE(update.moves.empty());
+  for (unsigned int t = 0; t < 4; ++t)
+  {
+    EXPECT_EQ(ids[t], t);
+    EXPECT_EQ(mesh.tet_edges(t), edges_before[t]);
+  }
+  EXPECT_EQ(mesh.get_boundary_faces().size(), 16u);
+}
