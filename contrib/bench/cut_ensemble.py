@@ -55,7 +55,7 @@ def settings_block(assignment):
     """`Sub/section/Entry=value` as nested prm subsections."""
     path, _, value = assignment.partition("=")
     parts = [p.strip() for p in path.split("/")]
-    if not value or len(parts) < 1 or not parts[-1]:
+    if not value.strip() or not parts[-1]:
         sys.exit(f"--set {assignment!r}: expected 'Subsection/Entry=value'")
     lines = [f"subsection {p}" for p in parts[:-1]]
     lines.append(f"set {parts[-1]} = {value.strip()}")
