@@ -11,10 +11,11 @@ with it rests on rounding ties (doc/cutting.md, "Limits"). Usage:
     contrib/bench/cut_ensemble.py build/lacerta prm/square_hole.prm --runs 20 \
         --set 'Cut/Snap fraction=0.1' --end-time 1.1
 
-Run k shifts every keyframe's tail and head by k*delta along x (runs 1-4), -x (5-9,
-with 1e-13 along y as well), and so on; run 0 is the scene unchanged. Each run is the
-scene in test mode with the statistics postprocessor only, in a temporary directory (--keep DIR
-keeps the parameter files, run<k>.prm, to rerun one).
+Run 0 is the scene unchanged. Runs 1-4 shift every keyframe's tail and head by 1-4
+delta along x, runs 5-8 by 1-4 delta along -x, runs 9-16 repeat that with delta along
+y as well, runs 17-24 with 2 delta along y, and so on (shift()). Each run is the
+scene in test mode with the statistics postprocessor only, in a temporary directory
+(--keep DIR keeps the parameter files, run<k>.prm, to rerun one).
 A piece is "major" if it holds at least --major of the total rest volume; the others
 are fragments. Needs python3 only.
 """

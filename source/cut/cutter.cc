@@ -520,11 +520,7 @@ namespace lacerta::cut
         around.clear();
         mesh.tets_around_edge(ends[0], ends[1], around);
         for (const unsigned int n : around)
-          if (tet_mark[n] != affected_stamp)
-          {
-            tet_mark[n] = affected_stamp;
-            affected.push_back(n);
-          }
+          join_affected(n);
       }
     std::sort(front_edge_ids.begin(), front_edge_ids.end());
     if (!analyse(surface))
@@ -1011,13 +1007,20 @@ namespace lacerta::cut
       if (missing.empty())
         return true;
       for (const unsigned int n : missing)
-        if (tet_mark[n] != affected_stamp)
-        {
-          tet_mark[n] = affected_stamp;
-          affected.push_back(n);
-        }
+        join_affected(n);
     }
     return false;
+  }
+
+
+  void
+  Cutter::join_affected(const unsigned int t)
+  {
+    if (tet_mark[t] != affected_stamp)
+    {
+      tet_mark[t] = affected_stamp;
+      affected.push_back(t);
+    }
   }
 
 

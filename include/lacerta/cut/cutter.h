@@ -289,6 +289,10 @@ namespace lacerta::cut
                         const SweepSurface &surface,
                         FaceScratch        &fs);
 
+    /// Adds tetrahedron @p t to the affected set unless it is there already.
+    void
+    join_affected(unsigned int t);
+
     /// Whether tetrahedron @p t has a cut edge or a front face in the analysis.
     bool
     tet_is_cut(unsigned int t) const;
