@@ -34,11 +34,30 @@ namespace lacerta::bench
     };
 
     /**
+     * What runs between two cuts of a stroke. The update's cost per cell depends on
+     * what is still in the cache when it starts, and that depends on what ran before
+     * it more than on the mesh: the choice isolates the two.
+     */
+    enum class Between
+    {
+      /// One RK4 step of the whole system, timed (RxT): as in a simulation.
+      relax,
+      /// Nothing: the update finds the previous update's data in the cache.
+      nothing,
+      /// 64 MiB read and written, twice the last-level cache: every line the update
+      /// touches comes from memory, whatever the mesh size.
+      flush
+    };
+
+    /**
      * A slab of n x n x 3 hexahedra (5 tetrahedra each, as the scenes) cut across by
-     * a vertical blade in @p n_steps steps; one RK4 step is timed after every cut.
+     * a vertical blade in @p n_steps steps; @p between runs after every cut.
      */
     Row
-    run(const unsigned int n, const unsigned int n_steps, const bool partial)
+    run(const unsigned int n,
+        const unsigned int n_steps,
+        const bool         partial,
+        const Between      between = Between::relax)
     {
       dealii::Triangulation<3> tria;
       dealii::GridGenerator::subdivided_hyper_rectangle_with_simplices(
@@ -62,16 +81,23 @@ namespace lacerta::bench
       parameters.max_advance = 100; // one sweep per step: CuT grows with the step
       cut::Cutter cutter(
         mesh, system, density, youngs, integral, parameters, blade(0.06));
-      Row          row;
-      const double end = partial ? 0.0 : -0.06;
+      Row                 row;
+      const double        end = partial ? 0.0 : -0.06;
+      std::vector<double> flush_buffer(between == Between::flush ? (64u << 20) / 8 : 0);
       for (unsigned int k = 1; k <= n_steps; ++k)
       {
         const auto s = cutter.move_blade(blade(0.06 + (end - 0.06) * k / n_steps));
         if (s.cut_tets == 0)
           continue;
-        rk4->initialize(system);
         const auto t0 = Clock::now();
-        rk4->step(system, 0.0, 1e-6);
+        if (between == Between::relax)
+        {
+          rk4->initialize(system);
+          rk4->step(system, 0.0, 1e-6);
+        }
+        else if (between == Between::flush)
+          for (double &x : flush_buffer)
+            x += 1.0;
         ++row.steps;
         row.cut += s.cut_tets;
         row.created += s.created_tets;
@@ -104,12 +130,15 @@ namespace lacerta::bench
     /// The run with the least update time of three: the machine is shared, and the
     /// least disturbed run is the closest to the cost of the update itself.
     Row
-    best_of_three(const unsigned int n, const unsigned int n_steps, const bool partial)
+    best_of_three(const unsigned int n,
+                  const unsigned int n_steps,
+                  const bool         partial,
+                  const Between      between = Between::relax)
     {
-      Row best = run(n, n_steps, partial);
+      Row best = run(n, n_steps, partial, between);
       for (unsigned int k = 1; k < 3; ++k)
       {
-        const Row r = run(n, n_steps, partial);
+        const Row r = run(n, n_steps, partial, between);
         if (r.update_ms < best.update_ms)
           best = r;
       }
@@ -158,20 +187,40 @@ namespace lacerta::bench
     int
     bench_cut(const std::vector<std::string> &arguments)
     {
-      if (arguments.size() == 2 || arguments.size() == 3)
+      if (arguments.size() >= 2 && arguments.size() <= 4)
       {
-        // One stroke (for profilers): n, steps and optionally "partial".
-        const unsigned int n     = static_cast<unsigned int>(std::stoul(arguments[0]));
-        const unsigned int steps = static_cast<unsigned int>(std::stoul(arguments[1]));
-        if (n < 1 || n > 200 || steps < 1 || steps > 100000
-            || (arguments.size() == 3 && arguments[2] != "partial"))
+        // One stroke (for profilers and for the cache study): n, steps, and
+        // optionally "partial" and what runs between the cuts.
+        const unsigned int n       = static_cast<unsigned int>(std::stoul(arguments[0]));
+        const unsigned int steps   = static_cast<unsigned int>(std::stoul(arguments[1]));
+        bool               partial = false, between_given = false;
+        bool               valid   = n >= 1 && n <= 200 && steps >= 1 && steps <= 100000;
+        Between            between = Between::relax;
+        for (std::size_t i = 2; i < arguments.size(); ++i)
+        {
+          const std::string &a = arguments[i];
+          if (a == "partial" && !partial)
+            partial = true;
+          else if ((a == "relax" || a == "nothing" || a == "flush") && !between_given)
+          {
+            between_given = true;
+            between       = a == "relax"     ? Between::relax
+                            : a == "nothing" ? Between::nothing
+                                             : Between::flush;
+          }
+          else
+            valid = false;
+        }
+        if (!valid)
         {
           std::fprintf(stderr,
-                       "lacerta-bench cut: expected n (1-200), steps (1-100000) and "
-                       "optionally 'partial'\n");
+                       "lacerta-bench cut: expected n (1-200), steps (1-100000), "
+                       "optionally 'partial', and optionally what runs between the "
+                       "cuts: 'relax' (an RK4 step, the default), 'nothing' or "
+                       "'flush' (64 MiB through the cache)\n");
           return 1;
         }
-        const Row r = best_of_three(n, steps, arguments.size() == 3);
+        const Row r = best_of_three(n, steps, partial, between);
         std::printf(
           "%8s %8s %8s %10s %10s %10s\n", "MS", "CuT", "CrT", "UpdT", "ReinitT", "RxT");
         print(r);
@@ -182,7 +231,8 @@ namespace lacerta::bench
       if (!arguments.empty())
       {
         std::fprintf(stderr,
-                     "lacerta-bench cut: expected no argument, or n steps [partial]\n");
+                     "lacerta-bench cut: expected no argument, or n steps [partial] "
+                     "[relax|nothing|flush]\n");
         return 1;
       }
       std::printf("Table 1 (averages over the steps that cut, the run with the least "
@@ -217,7 +267,9 @@ namespace lacerta::bench
                              "the paper's Table 1: mesh size, tetrahedra cut and created "
                              "per step, mesh update and relaxation time; update time "
                              "against cut size and mesh size, per phase (arguments: "
-                             "none, or n steps [partial] for one stroke across a slab "
-                             "of n x n x 3 x 5 tetrahedra)",
+                             "none, or n steps [partial] [relax|nothing|flush] for one "
+                             "stroke across a slab of n x n x 3 x 5 tetrahedra, with an "
+                             "RK4 step, nothing, or 64 MiB of memory traffic between "
+                             "the cuts)",
                              bench_cut);
 } // namespace lacerta::bench
