@@ -758,11 +758,19 @@ namespace lacerta::cut
     // Reached: a vertex of the crack when behind the new front; a fresh one when also
     // not behind the start of this sweep by more than a cell (the plane must not
     // reach back along an older part of the crack), or when an earlier sweep of the
-    // stroke swept it.
-    s.reached        = on_surface[v]
-                         ? surface.behind(at) < 0
-                         : (surface.behind(x) < 0 && surface.ahead_of_start(x) >= -start_reach)
-                      || swept[v] == stroke;
+    // stroke swept it. While the front is brought to a corner, a vertex of the crack
+    // in the plane up to a quarter of an edge beyond the corner is reached too: where
+    // a closed path comes back to its start, the corner is where the blade turned
+    // between two steps, short of the crack's first vertices; a face in the plane
+    // through one of them was cut only up to the corner, the next side's plane (which
+    // turns away) never met the rest of it, and it held the disc (a closed
+    // Catmull-Rom circle and a polygon of 64 sides per turn punched nothing).
+    const double beyond = surface.behind(at);
+    s.reached =
+      on_surface[v]
+        ? beyond < 0 || (catching_up && on_crack && beyond < 0.25 * typical_edge)
+        : (surface.behind(x) < 0 && surface.ahead_of_start(x) >= -start_reach)
+            || swept[v] == stroke;
     s.sweep_on_plane = s.on_plane;
     s.sweep_reached  = s.reached;
     return s;

@@ -528,3 +528,59 @@ TEST(CutCutter, SelfCrossingOverATwistingCrackPunchesTheSquare)
   ASSERT_EQ(pieces.size(), 2u) << "pieces:" << listing;
   EXPECT_NEAR(pieces[0] + pieces[1], 1.0, 1e-12);
 }
+
+
+namespace
+{
+  /// Volumes of the pieces after a circle (centre (0.5, 0.5), radius 0.3) through the
+  /// box of 4^3 cubes, run as a polygon of @p corners sides per turn in @p steps steps
+  /// per side, one turn and an eighth (past its start), entering from above and
+  /// lifted out.
+  std::vector<double>
+  punch_circle(const unsigned int corners, const unsigned int steps)
+  {
+    std::mt19937       rng(5);
+    std::vector<Blade> loop;
+    const double       pi = 3.141592653589793;
+    for (unsigned int k = 0; k <= corners + corners / 8; ++k)
+    {
+      const double a = -pi / 2 + 2 * pi * k / corners;
+      loop.push_back(vertical(0.5 + 0.3 * std::cos(a), 0.5 + 0.3 * std::sin(a)));
+    }
+    const Blade above{{{0.5, 0.2, 2.5}}, {{0.5, 0.2, 1.2}}};
+    const Point end = loop.back().tail;
+    const Blade lifted{{{end[0], end[1], 2.5}}, {{end[0], end[1], 1.2}}};
+    CutFixture  f(4, rng, above);
+    f.stroke({above, loop[0]}, 4);
+    f.stroke(loop, steps);
+    f.stroke({loop.back(), lifted}, 4);
+    if (::testing::Test::HasFatalFailure())
+      return {};
+    return f.component_volumes();
+  }
+} // namespace
+
+
+// A gradual closed turn: the path turns by 5.6 degrees at each corner, so the front
+// is brought to a corner only where the turns add up to more than 0.3 rad, at
+// arbitrary points, and when the path comes back to its start the last corner lies
+// short of the crack's first vertices. Before a catch-up took in the crack just beyond
+// its corner, the face through those vertices stayed closed and nothing came out.
+TEST(CutCutter, GradualClosedTurnPunchesADisc)
+{
+  const double cylinder = 3.141592653589793 * 0.3 * 0.3;
+  for (const unsigned int steps : {2u, 4u, 8u})
+  {
+    const auto pieces = punch_circle(64, steps);
+    ASSERT_FALSE(::testing::Test::HasFatalFailure()) << steps << " steps per side";
+    std::string listing;
+    for (const double v : pieces)
+      listing += " " + std::to_string(v);
+    ASSERT_EQ(pieces.size(), 2u) << steps << " steps per side, pieces:" << listing;
+    // The crack is a polygon of the catch-up chords (each over at least 0.3 rad):
+    // the disc is a little smaller than the cylinder, never larger.
+    EXPECT_GT(pieces[0], 0.95 * cylinder) << steps << " steps per side";
+    EXPECT_LT(pieces[0], cylinder) << steps << " steps per side";
+    EXPECT_NEAR(pieces[0] + pieces[1], 1.0, 1e-12) << steps << " steps per side";
+  }
+}
