@@ -589,15 +589,40 @@ namespace lacerta::mesh
     // cells appears in several of them) without searching a star again.
     auto &new_edge_ids = scratch.new_edge_ids;
     new_edge_ids.resize(added.size());
-    // The new cells have about 1.5 distinct edges each, but a few cells apart from
-    // each other have up to six: the table has room for six per cell (8 slots per
-    // cell, so it never fills and the probing always ends), and, cleared at every
-    // update, evicts little from the cache.
+    // The table first takes the removed cells' edges with their ids: most edges of
+    // the new cells that already exist are theirs, found without a star search (an
+    // edge id names one edge, so the id is the one the search would find). The new
+    // cells have about 1.5 distinct edges each, but a few cells apart from each other
+    // have up to six: the table has room for six per cell involved (8 slots per cell,
+    // so it never fills and the probing always ends), and, cleared at every update,
+    // evicts little from the cache.
     std::size_t table_size = 16;
-    while (table_size < 8 * added.size())
+    while (table_size < 8 * (added.size() + removed.size()))
       table_size *= 2;
     auto &created = scratch.created;
     created.assign(table_size, {{invalid_index, invalid_index, invalid_index}});
+    // The slot of edge (a, b): its entry, or the empty slot where it goes.
+    const auto find_created = [&](const unsigned int a,
+                                  const unsigned int b) -> std::array<unsigned int, 3> &
+    {
+      std::size_t h = ((std::size_t(a) * 0x9E3779B97F4A7C15ULL)
+                       ^ (std::size_t(b) * 0xC2B2AE3D27D4EB4FULL))
+                      >> 20;
+      for (h &= table_size - 1;; h = (h + 1) & (table_size - 1))
+      {
+        auto &slot = created[h];
+        if (slot[2] == invalid_index || (slot[0] == a && slot[1] == b))
+          return slot;
+      }
+    };
+    for (const unsigned int r : removed)
+      for (unsigned int e = 0; e < 6; ++e)
+      {
+        const unsigned int x = tets[r][edge_vertices[e][0]],
+                           y = tets[r][edge_vertices[e][1]];
+        const unsigned int a = lesser(x, y), b = x ^ y ^ a;
+        find_created(a, b) = {{a, b, tet_edge_ids[r][e]}};
+      }
     for (std::size_t k = 0; k < added.size(); ++k)
       for (unsigned int e = 0; e < 6; ++e)
       {
@@ -605,32 +630,20 @@ namespace lacerta::mesh
                            y = added[k][edge_vertices[e][1]];
         // Ordered without a branch (which end is smaller follows no pattern).
         const unsigned int a = lesser(x, y), b = x ^ y ^ a;
-        unsigned int       id = invalid_index;
-        std::size_t        h  = ((std::size_t(a) * 0x9E3779B97F4A7C15ULL)
-                         ^ (std::size_t(b) * 0xC2B2AE3D27D4EB4FULL))
-                        >> 20;
-        for (h &= table_size - 1;; h = (h + 1) & (table_size - 1))
+        auto              &slot = find_created(a, b);
+        if (slot[2] == invalid_index)
         {
-          auto &slot = created[h];
-          if (slot[2] == invalid_index)
+          // Not an edge of a removed cell: one of a surviving cell, or a new one.
+          unsigned int id = find_edge(a, b);
+          if (id == invalid_index)
           {
-            id = find_edge(a, b);
-            if (id == invalid_index)
-            {
-              id = static_cast<unsigned int>(edges.size());
-              edges.push_back({{a, b}});
-              ++update.n_added;
-            }
-            slot = {{a, b, id}};
-            break;
+            id = static_cast<unsigned int>(edges.size());
+            edges.push_back({{a, b}});
+            ++update.n_added;
           }
-          if (slot[0] == a && slot[1] == b)
-          {
-            id = slot[2];
-            break;
-          }
+          slot = {{a, b, id}};
         }
-        new_edge_ids[k][e] = id;
+        new_edge_ids[k][e] = slot[2];
       }
 
     // Vertices whose boundary flag may change: those of the old and the new tets.
