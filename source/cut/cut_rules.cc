@@ -34,8 +34,9 @@ namespace lacerta::cut
                 std::vector<unsigned int>   &group)
   {
     // Union-find over the cells; the faces through v are matched by their two other
-    // nodes (sorted), so no map is needed. The working arrays are kept per thread:
-    // the cutter calls this for every vertex on the cut, and should not allocate.
+    // nodes in a small hash table (a sort of the faces was the most mispredicted code
+    // of the update). The working arrays are kept per thread: the cutter calls this
+    // for every vertex on the cut, and should not allocate.
     static thread_local std::vector<std::size_t> parent;
     parent.resize(star.size());
     std::iota(parent.begin(), parent.end(), 0);
@@ -45,14 +46,24 @@ namespace lacerta::cut
         i = parent[i] = parent[parent[i]];
       return i;
     };
-    struct FaceRef
+    // One entry per distinct face: its first cell, and whether any of its cells has it
+    // on the cut. The groups follow from which cells are joined, not from the order
+    // of the joins, so the result is that of any grouping of equal faces.
+    struct FaceGroup
     {
       std::uint64_t a, b;
-      std::size_t   cell;
-      bool          cut;
+      std::size_t   first_cell;
+      bool          used, cut;
     };
-    static thread_local std::vector<FaceRef> faces;
-    faces.clear();
+    static thread_local std::vector<FaceGroup>   table;
+    static thread_local std::vector<std::size_t> face_cell, face_group;
+    face_cell.clear();
+    face_group.clear();
+    unsigned int bits = 4;
+    while ((std::size_t(1) << bits) < 8 * star.size())
+      ++bits;
+    const std::size_t mask = (std::size_t(1) << bits) - 1;
+    table.assign(mask + 1, {0, 0, 0, false, false});
     for (std::size_t i = 0; i < star.size(); ++i)
     {
       const auto &n = star[i].nodes;
@@ -67,29 +78,29 @@ namespace lacerta::cut
             other[k++] = n[m];
         if (k != 2)
           continue;
-        faces.push_back({std::min(other[0], other[1]),
-                         std::max(other[0], other[1]),
-                         i,
-                         (star[i].cut_faces & (1u << j)) != 0});
+        const std::uint64_t a = std::min(other[0], other[1]),
+                            b = std::max(other[0], other[1]);
+        // At most three faces per cell: the table, with room for eight, never fills.
+        std::size_t h =
+          (a * 0x9E3779B97F4A7C15ULL + b * 0xC2B2AE3D27D4EB4FULL) >> (64 - bits);
+        while (table[h].used & ((table[h].a != a) | (table[h].b != b)))
+          h = (h + 1) & mask;
+        FaceGroup &g = table[h];
+        // Selects, not branches: whether the face was seen follows no pattern.
+        g.first_cell = g.used ? g.first_cell : i;
+        g.cut        = g.cut | ((star[i].cut_faces & (1u << j)) != 0);
+        g.a          = a;
+        g.b          = b;
+        g.used       = true;
+        face_cell.push_back(i);
+        face_group.push_back(h);
       }
     }
-    std::sort(faces.begin(),
-              faces.end(),
-              [](const FaceRef &x, const FaceRef &y)
-              { return x.a != y.a ? x.a < y.a : x.b < y.b; });
-    for (std::size_t b = 0; b < faces.size();)
+    for (std::size_t f = 0; f < face_cell.size(); ++f)
     {
-      std::size_t e   = b;
-      bool        cut = false;
-      while (e < faces.size() && faces[e].a == faces[b].a && faces[e].b == faces[b].b)
-      {
-        cut = cut || faces[e].cut;
-        ++e;
-      }
-      if (!cut)
-        for (std::size_t i = b + 1; i < e; ++i)
-          parent[find(faces[i].cell)] = find(faces[b].cell);
-      b = e;
+      const FaceGroup &g = table[face_group[f]];
+      if (!g.cut)
+        parent[find(face_cell[f])] = find(g.first_cell);
     }
     group.assign(star.size(), 0);
     static thread_local std::vector<std::size_t> roots;

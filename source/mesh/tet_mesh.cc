@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numeric>
 
@@ -52,6 +53,33 @@ namespace lacerta::mesh
     {
       std::sort(ids.begin(), ids.end());
       return ids;
+    }
+
+
+    /// The smaller of @p x and @p y, computed without a branch (GCC compiles
+    /// std::min of these to one, and which is smaller follows no pattern).
+    inline unsigned int
+    lesser(const unsigned int x, const unsigned int y)
+    {
+      return y ^ ((x ^ y) & (0u - static_cast<unsigned int>(x < y)));
+    }
+
+
+    /// A face's three vertex ids, sorted: the key that names it from either side.
+    using FaceKey = std::array<unsigned int, 3>;
+
+
+    /// The key of local face @p f of @p cell, sorted without branches.
+    inline FaceKey
+    face_key(const Tet &cell, const unsigned int f)
+    {
+      const unsigned int a = cell[TetMesh::face_vertices[f][0]],
+                         b = cell[TetMesh::face_vertices[f][1]],
+                         c = cell[TetMesh::face_vertices[f][2]];
+      // x ^ y ^ lesser(x, y) is the greater one.
+      const unsigned int low_ab = lesser(a, b), high_ab = a ^ b ^ low_ab;
+      const unsigned int low = lesser(low_ab, c), high = high_ab ^ c ^ lesser(high_ab, c);
+      return {{low, a ^ b ^ c ^ low ^ high, high}};
     }
   } // namespace
 
@@ -467,6 +495,10 @@ namespace lacerta::mesh
       replace_scratch.vertex_stamp.resize(vertices.size(), 0);
       replace_scratch.edge_stamp.reserve(n_edges);
       replace_scratch.edge_stamp.resize(edges.size(), 0);
+      replace_scratch.fresh_stamp.reserve(n_vertices);
+      replace_scratch.fresh_stamp.resize(vertices.size(), 0);
+      replace_scratch.tet_stamp.reserve(n_tets);
+      replace_scratch.tet_stamp.resize(tets.size(), 0);
     }
   }
 
@@ -557,47 +589,61 @@ namespace lacerta::mesh
     // cells appears in several of them) without searching a star again.
     auto &new_edge_ids = scratch.new_edge_ids;
     new_edge_ids.resize(added.size());
-    // The new cells have about 1.5 distinct edges each, but a few cells apart from
-    // each other have up to six: the table has room for six per cell (8 slots per
-    // cell, so it never fills and the probing always ends), and, cleared at every
-    // update, evicts little from the cache.
+    // The table first takes the removed cells' edges with their ids: most edges of
+    // the new cells that already exist are theirs, found without a star search (an
+    // edge id names one edge, so the id is the one the search would find). The new
+    // cells have about 1.5 distinct edges each, but a few cells apart from each other
+    // have up to six: the table has room for six per cell involved (8 slots per cell,
+    // so it never fills and the probing always ends), and, cleared at every update,
+    // evicts little from the cache.
     std::size_t table_size = 16;
-    while (table_size < 8 * added.size())
+    while (table_size < 8 * (added.size() + removed.size()))
       table_size *= 2;
     auto &created = scratch.created;
     created.assign(table_size, {{invalid_index, invalid_index, invalid_index}});
+    // The slot of edge (a, b): its entry, or the empty slot where it goes.
+    const auto find_created = [&](const unsigned int a,
+                                  const unsigned int b) -> std::array<unsigned int, 3> &
+    {
+      std::size_t h = ((std::size_t(a) * 0x9E3779B97F4A7C15ULL)
+                       ^ (std::size_t(b) * 0xC2B2AE3D27D4EB4FULL))
+                      >> 20;
+      for (h &= table_size - 1;; h = (h + 1) & (table_size - 1))
+      {
+        auto &slot = created[h];
+        if (slot[2] == invalid_index || (slot[0] == a && slot[1] == b))
+          return slot;
+      }
+    };
+    for (const unsigned int r : removed)
+      for (unsigned int e = 0; e < 6; ++e)
+      {
+        const unsigned int x = tets[r][edge_vertices[e][0]],
+                           y = tets[r][edge_vertices[e][1]];
+        const unsigned int a = lesser(x, y), b = x ^ y ^ a;
+        find_created(a, b) = {{a, b, tet_edge_ids[r][e]}};
+      }
     for (std::size_t k = 0; k < added.size(); ++k)
       for (unsigned int e = 0; e < 6; ++e)
       {
-        unsigned int a = added[k][edge_vertices[e][0]], b = added[k][edge_vertices[e][1]];
-        if (a > b)
-          std::swap(a, b);
-        unsigned int id = invalid_index;
-        std::size_t  h  = ((std::size_t(a) * 0x9E3779B97F4A7C15ULL)
-                         ^ (std::size_t(b) * 0xC2B2AE3D27D4EB4FULL))
-                        >> 20;
-        for (h &= table_size - 1;; h = (h + 1) & (table_size - 1))
+        const unsigned int x = added[k][edge_vertices[e][0]],
+                           y = added[k][edge_vertices[e][1]];
+        // Ordered without a branch (which end is smaller follows no pattern).
+        const unsigned int a = lesser(x, y), b = x ^ y ^ a;
+        auto              &slot = find_created(a, b);
+        if (slot[2] == invalid_index)
         {
-          auto &slot = created[h];
-          if (slot[2] == invalid_index)
+          // Not an edge of a removed cell: one of a surviving cell, or a new one.
+          unsigned int id = find_edge(a, b);
+          if (id == invalid_index)
           {
-            id = find_edge(a, b);
-            if (id == invalid_index)
-            {
-              id = static_cast<unsigned int>(edges.size());
-              edges.push_back({{a, b}});
-              ++update.n_added;
-            }
-            slot = {{a, b, id}};
-            break;
+            id = static_cast<unsigned int>(edges.size());
+            edges.push_back({{a, b}});
+            ++update.n_added;
           }
-          if (slot[0] == a && slot[1] == b)
-          {
-            id = slot[2];
-            break;
-          }
+          slot = {{a, b, id}};
         }
-        new_edge_ids[k][e] = id;
+        new_edge_ids[k][e] = slot[2];
       }
 
     // Vertices whose boundary flag may change: those of the old and the new tets.
@@ -605,9 +651,12 @@ namespace lacerta::mesh
     {
       std::fill(scratch.vertex_stamp.begin(), scratch.vertex_stamp.end(), 0u);
       std::fill(scratch.edge_stamp.begin(), scratch.edge_stamp.end(), 0u);
+      std::fill(scratch.fresh_stamp.begin(), scratch.fresh_stamp.end(), 0u);
+      std::fill(scratch.tet_stamp.begin(), scratch.tet_stamp.end(), 0u);
       scratch.stamp = 1;
     }
     scratch.vertex_stamp.resize(vertices.size(), 0);
+    scratch.fresh_stamp.resize(vertices.size(), 0);
     scratch.refresh.clear();
     const auto note_vertex = [&](const unsigned int v)
     {
@@ -628,6 +677,36 @@ namespace lacerta::mesh
     for (const auto &ids : new_edge_ids)
       for (const unsigned int id : ids)
         scratch.edge_stamp[id] = scratch.stamp;
+    // Faces by key, for the neighbours below: the removed cells' faces whose
+    // neighbour survives go in now, the new cells' faces later. The table holds at
+    // most four faces per cell involved, so it never fills and probing always ends.
+    std::size_t face_table_size = 16;
+    while (face_table_size <= 4 * (added.size() + removed.size()))
+      face_table_size *= 2;
+    auto &face_table = scratch.faces;
+    face_table.assign(face_table_size,
+                      {{invalid_index, invalid_index, invalid_index, invalid_index}});
+    const auto find_face = [&](const FaceKey &key) -> std::array<unsigned int, 4> &
+    {
+      std::size_t h = (std::size_t(key[0]) * 0x9E3779B97F4A7C15ULL
+                       + std::size_t(key[1]) * 0xC2B2AE3D27D4EB4FULL
+                       + std::size_t(key[2]) * 0x165667B19E3779F9ULL)
+                      >> 20;
+      for (h &= face_table_size - 1;; h = (h + 1) & (face_table_size - 1))
+      {
+        // Stop at the face or at an empty slot (slot[0] + 1 wraps to 0): one test
+        // of a product, as GCC splits a disjunction of comparisons into branches
+        // again, and which of the two it is follows no pattern.
+        auto              &slot = face_table[h];
+        const unsigned int differs =
+          (slot[0] ^ key[0]) | (slot[1] ^ key[1]) | (slot[2] ^ key[2]);
+        if (std::uint64_t(differs) * std::uint32_t(slot[0] + 1u) == 0)
+          return slot;
+      }
+    };
+    scratch.tet_stamp.resize(tets.size(), 0);
+    for (const unsigned int r : removed)
+      scratch.tet_stamp[r] = scratch.stamp;
     for (const unsigned int r : removed)
     {
       for (unsigned int e = 0; e < 6; ++e)
@@ -640,10 +719,7 @@ namespace lacerta::mesh
         old_edges.push_back({{std::min(a, b), std::max(a, b), id}});
       }
       for (const unsigned int v : tets[r])
-      {
-        vertex_tets.erase(v, r);
         note_vertex(v);
-      }
       for (unsigned int f = 0; f < 4; ++f)
       {
         remove_boundary_face(r, f);
@@ -651,10 +727,24 @@ namespace lacerta::mesh
         if (n != invalid_index)
           for (unsigned int g = 0; g < 4; ++g)
             if (neighbors[4 * n + g] == r)
+            {
               neighbors[4 * n + g] = invalid_index;
+              if (scratch.tet_stamp[n] != scratch.stamp)
+              {
+                const FaceKey key = face_key(tets[r], f);
+                find_face(key)    = {{key[0], key[1], key[2], 4 * n + g}};
+              }
+            }
         neighbors[4 * r + f] = invalid_index;
       }
     }
+
+    // The removed tets leave the stars of their vertices (so far exactly the noted
+    // ones), all of a star's at once.
+    for (const unsigned int v : scratch.refresh)
+      vertex_tets.erase_marked(v,
+                               [&](const unsigned int t)
+                               { return scratch.tet_stamp[t] == scratch.stamp; });
 
     // Put the new tets in: the first ones into the removed ones' slots, the others
     // appended (the arrays grow once, not once per tet).
@@ -674,12 +764,43 @@ namespace lacerta::mesh
       tet_edge_ids[slot]      = new_edge_ids[k];
       for (const unsigned int v : added[k])
       {
+        // A vertex whose star is empty now is held by new cells only.
+        if (vertex_tets.star_size(v) == 0)
+          scratch.fresh_stamp[v] = scratch.stamp;
         vertex_tets.insert(v, slot);
         note_vertex(v);
       }
     }
-    // Neighbours: the tet sharing a face is in the star of each of the face's
-    // vertices (the caller guarantees there is at most one): search the smallest.
+    // Neighbours, by the faces' sorted vertex triples (a face has at most two cells,
+    // the caller guarantees it, and a neighbour shares all three vertices). The other
+    // cell of a new cell's face is another new cell, or a surviving cell that was the
+    // neighbour of a removed one across that face (listed above), or, rarely, a
+    // surviving cell whose face was on the boundary: only the faces still without a
+    // neighbour are searched for in a star, and not even those with a vertex that only
+    // new cells hold. A table lookup instead of a star scan per face: the scan's
+    // membership tests were the update's most mispredicted branches.
+    for (std::size_t k = 0; k < added.size(); ++k)
+    {
+      const unsigned int t = added_ids[k];
+      for (unsigned int f = 0; f < 4; ++f)
+      {
+        const FaceKey key  = face_key(tets[t], f);
+        auto         &slot = find_face(key);
+        // Whether the face is already there (half of them) follows no pattern:
+        // selects instead of branches. A hit leaves the entry as it is; a miss
+        // enters the face and writes invalid_index where it already is
+        // (masks: GCC compiles the selects of `hit ? :` to branches).
+        const unsigned int hit = 0u - static_cast<unsigned int>(slot[0] != invalid_index);
+        const unsigned int own = 4 * t + f;
+        const unsigned int other = (slot[3] & hit) | (own & ~hit);
+        slot                     = {{key[0], key[1], key[2], other}};
+        neighbors[own]           = (other / 4) | ~hit;
+        neighbors[other]         = t | ~hit;
+      }
+    }
+    // The faces left are boundary faces unless a surviving cell has the same three
+    // vertices (the new cells then close a boundary). In the order of the new cells
+    // and their faces, as the boundary face list's order depends on it.
     for (std::size_t k = 0; k < added.size(); ++k)
     {
       const unsigned int t = added_ids[k];
@@ -687,29 +808,34 @@ namespace lacerta::mesh
       {
         if (neighbors[4 * t + f] != invalid_index)
           continue;
-        unsigned int v[3] = {tets[t][face_vertices[f][0]],
-                             tets[t][face_vertices[f][1]],
-                             tets[t][face_vertices[f][2]]};
-        for (unsigned int i = 1; i < 3; ++i)
-          if (vertex_tets.star_size(v[i]) < vertex_tets.star_size(v[0]))
-            std::swap(v[0], v[i]);
+        unsigned int v[3]  = {tets[t][face_vertices[f][0]],
+                              tets[t][face_vertices[f][1]],
+                              tets[t][face_vertices[f][2]]};
         unsigned int other = invalid_index, other_face = 0;
-        for (const unsigned int s : vertex_tets[v[0]])
+        if (scratch.fresh_stamp[v[0]] != scratch.stamp
+            && scratch.fresh_stamp[v[1]] != scratch.stamp
+            && scratch.fresh_stamp[v[2]] != scratch.stamp)
         {
-          if (s == t)
-            continue;
-          const Tet &q = tets[s];
-          // Without short-circuits: most cells of the star lack v[1] or v[2], at
-          // positions no branch predictor learns.
-          const auto has = [&](const unsigned int w)
-          { return (q[0] == w) | (q[1] == w) | (q[2] == w) | (q[3] == w); };
-          if (has(v[1]) & has(v[2]))
+          for (unsigned int i = 1; i < 3; ++i)
+            if (vertex_tets.star_size(v[i]) < vertex_tets.star_size(v[0]))
+              std::swap(v[0], v[i]);
+          for (const unsigned int s : vertex_tets[v[0]])
           {
-            other = s;
-            for (unsigned int g = 0; g < 4; ++g)
-              if (q[g] != v[0] && q[g] != v[1] && q[g] != v[2])
-                other_face = g;
-            break;
+            if (s == t)
+              continue;
+            const Tet &q = tets[s];
+            // Without short-circuits: most cells of the star lack v[1] or v[2], at
+            // positions no branch predictor learns.
+            const auto has = [&](const unsigned int w)
+            { return (q[0] == w) | (q[1] == w) | (q[2] == w) | (q[3] == w); };
+            if (has(v[1]) & has(v[2]))
+            {
+              other = s;
+              for (unsigned int g = 0; g < 4; ++g)
+                if (q[g] != v[0] && q[g] != v[1] && q[g] != v[2])
+                  other_face = g;
+              break;
+            }
           }
         }
         if (other == invalid_index)
@@ -755,12 +881,22 @@ namespace lacerta::mesh
     {
       if (v >= boundary_vertex.size())
         boundary_vertex.resize(v + 1, 0);
-      std::uint8_t            on_boundary = 0;
-      const VertexStars::Star star        = vertex_tets[v];
-      for (auto t = star.begin(); !on_boundary && t != star.end(); ++t)
-        for (unsigned int f = 0; f < 4; ++f)
-          if (neighbors[4 * *t + f] == invalid_index && tets[*t][f] != v)
-            on_boundary = 1;
+      std::uint8_t on_boundary = 0;
+      for (const unsigned int t : vertex_tets[v])
+      {
+        // A face without a neighbour that holds v (not the one opposite v), tested
+        // for the four faces at once: which of them is open follows no pattern.
+        const unsigned int *n = &neighbors[4 * t];
+        const Tet          &q = tets[t];
+        if (((n[0] == invalid_index) & (q[0] != v))
+            | ((n[1] == invalid_index) & (q[1] != v))
+            | ((n[2] == invalid_index) & (q[2] != v))
+            | ((n[3] == invalid_index) & (q[3] != v)))
+        {
+          on_boundary = 1;
+          break;
+        }
+      }
       boundary_vertex[v] = on_boundary;
     }
   }

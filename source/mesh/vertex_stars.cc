@@ -106,4 +106,21 @@ namespace lacerta::mesh
       free_overflow.push_back(index);
     }
   }
+
+
+  void
+  VertexStars::shrink_overflowing(const unsigned int v)
+  {
+    unsigned int              *s    = slot(v);
+    std::vector<unsigned int> &list = overflow[s[1]];
+    s[0]                            = static_cast<unsigned int>(list.size());
+    if (s[0] <= slot_words - 1)
+    {
+      // Back in place: the slot's word 1 (the index) is overwritten by the first id.
+      const unsigned int index = s[1];
+      std::copy(list.begin(), list.end(), s + 1);
+      list.clear();
+      free_overflow.push_back(index);
+    }
+  }
 } // namespace lacerta::mesh

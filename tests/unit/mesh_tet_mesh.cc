@@ -1,11 +1,15 @@
-// TetMesh: connectivity, orientation, refusal of degenerate input, spatial sorting.
+// TetMesh: connectivity, orientation, refusal of degenerate input, spatial sorting,
+// local replacements against a plain reference.
 
 #include <lacerta/base/exceptions.h>
 #include <lacerta/mesh/tet_mesh.h>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <random>
 #include <set>
 
 using namespace lacerta;
@@ -172,4 +176,413 @@ TEST(TetMesh, ReplacingCellsApartFromEachOtherKeepsTheirEdges)
     EXPECT_EQ(mesh.tet_edges(t), edges_before[t]);
   }
   EXPECT_EQ(mesh.get_boundary_faces().size(), 16u);
+}
+
+
+namespace
+{
+  /// A face by its sorted vertex ids.
+  std::array<unsigned int, 3>
+  face_of(const Tet &cell, const unsigned int f)
+  {
+    std::array<unsigned int, 3> key = {{cell[TetMesh::face_vertices[f][0]],
+                                        cell[TetMesh::face_vertices[f][1]],
+                                        cell[TetMesh::face_vertices[f][2]]}};
+    std::sort(key.begin(), key.end());
+    return key;
+  }
+
+
+  /**
+   * replace_tets() done the plain way: the removed cells leave the boundary face list
+   * face by face, then every new cell's face without a neighbour yet looks for the
+   * other cell with its three vertices among all cells and either joins it (and takes
+   * it off the list) or enters the list. The list's order is part of the result (it
+   * feeds the first contact of the cutter).
+   */
+  struct ReferenceMesh
+  {
+    std::vector<Tet>                         tets;
+    std::vector<std::array<unsigned int, 4>> neighbors;
+    std::vector<BoundaryFace>                boundary;
+
+    explicit ReferenceMesh(const TetMesh &mesh)
+        : tets(mesh.get_tets())
+        , boundary(mesh.get_boundary_faces())
+    {
+      for (unsigned int t = 0; t < mesh.n_tets(); ++t)
+        neighbors.push_back({{mesh.neighbor(t, 0),
+                              mesh.neighbor(t, 1),
+                              mesh.neighbor(t, 2),
+                              mesh.neighbor(t, 3)}});
+    }
+
+    void
+    remove_boundary_face(const unsigned int t, const unsigned int f)
+    {
+      for (std::size_t i = 0; i < boundary.size(); ++i)
+        if (boundary[i].tet == t && boundary[i].face == f)
+        {
+          boundary[i] = boundary.back();
+          boundary.pop_back();
+          return;
+        }
+    }
+
+    void
+    replace(const std::vector<unsigned int>                &removed,
+            const std::vector<Tet>                         &added,
+            const std::vector<std::array<unsigned int, 4>> &face_ids)
+    {
+      for (const unsigned int r : removed)
+        for (unsigned int f = 0; f < 4; ++f)
+        {
+          remove_boundary_face(r, f);
+          const unsigned int n = neighbors[r][f];
+          if (n != invalid_index)
+            for (unsigned int &back : neighbors[n])
+              if (back == r)
+                back = invalid_index;
+          neighbors[r][f] = invalid_index;
+        }
+      std::vector<unsigned int> ids;
+      for (std::size_t k = 0; k < added.size(); ++k)
+      {
+        ids.push_back(k < removed.size() ? removed[k] : tets.size());
+        if (k >= removed.size())
+        {
+          tets.emplace_back();
+          neighbors.push_back(
+            {{invalid_index, invalid_index, invalid_index, invalid_index}});
+        }
+        tets[ids.back()] = added[k];
+      }
+      for (std::size_t k = 0; k < added.size(); ++k)
+        for (unsigned int f = 0; f < 4; ++f)
+        {
+          const unsigned int t = ids[k];
+          if (neighbors[t][f] != invalid_index)
+            continue;
+          const auto   key   = face_of(tets[t], f);
+          unsigned int other = invalid_index, other_face = 0;
+          for (unsigned int s = 0; s < tets.size() && other == invalid_index; ++s)
+            for (unsigned int g = 0; g < 4 && s != t; ++g)
+              if (face_of(tets[s], g) == key)
+              {
+                other      = s;
+                other_face = g;
+              }
+          if (other == invalid_index)
+            boundary.push_back({t, f, face_ids[k][f]});
+          else
+          {
+            neighbors[t][f]              = other;
+            neighbors[other][other_face] = t;
+            remove_boundary_face(other, other_face);
+          }
+        }
+    }
+  };
+
+
+  /// Whether replacing @p removed by @p added leaves every face with at most two cells.
+  bool
+  stays_manifold(const std::vector<Tet>          &tets,
+                 const std::vector<unsigned int> &removed,
+                 const std::vector<Tet>          &added)
+  {
+    std::vector<bool> gone(tets.size(), false);
+    for (const unsigned int r : removed)
+      gone[r] = true;
+    std::map<std::array<unsigned int, 3>, unsigned int> count;
+    for (unsigned int t = 0; t < tets.size(); ++t)
+      for (unsigned int f = 0; f < 4 && !gone[t]; ++f)
+        ++count[face_of(tets[t], f)];
+    for (const Tet &cell : added)
+      for (unsigned int f = 0; f < 4; ++f)
+        if (++count[face_of(cell, f)] > 2)
+          return false;
+    return true;
+  }
+
+
+  /// Checks @p mesh's connectivity against one computed from its cells alone.
+  void
+  expect_connectivity_from_scratch(const TetMesh &mesh, const std::string &where)
+  {
+    std::map<std::array<unsigned int, 3>, std::vector<unsigned int>> cells_of_face;
+    std::set<std::array<unsigned int, 2>>                            edges;
+    for (unsigned int t = 0; t < mesh.n_tets(); ++t)
+    {
+      for (unsigned int f = 0; f < 4; ++f)
+        cells_of_face[face_of(mesh.tet(t), f)].push_back(4 * t + f);
+      for (unsigned int e = 0; e < 6; ++e)
+      {
+        unsigned int a = mesh.tet(t)[TetMesh::edge_vertices[e][0]],
+                     b = mesh.tet(t)[TetMesh::edge_vertices[e][1]];
+        const std::array<unsigned int, 2> edge = {{std::min(a, b), std::max(a, b)}};
+        edges.insert(edge);
+        ASSERT_EQ(mesh.get_edges()[mesh.tet_edges(t)[e]], edge) << where;
+      }
+    }
+    std::set<std::array<unsigned int, 2>> boundary;
+    std::vector<bool>                     on_boundary(mesh.n_vertices(), false);
+    for (const auto &[key, owners] : cells_of_face)
+    {
+      ASSERT_LE(owners.size(), 2u) << where;
+      if (owners.size() == 2)
+      {
+        EXPECT_EQ(mesh.neighbor(owners[0] / 4, owners[0] % 4), owners[1] / 4) << where;
+        EXPECT_EQ(mesh.neighbor(owners[1] / 4, owners[1] % 4), owners[0] / 4) << where;
+      }
+      else
+      {
+        EXPECT_EQ(mesh.neighbor(owners[0] / 4, owners[0] % 4), invalid_index) << where;
+        boundary.insert({{owners[0] / 4, owners[0] % 4}});
+        for (const unsigned int v : key)
+          on_boundary[v] = true;
+      }
+    }
+    std::set<std::array<unsigned int, 2>> listed;
+    for (const BoundaryFace &bf : mesh.get_boundary_faces())
+      listed.insert({{bf.tet, bf.face}});
+    EXPECT_EQ(listed, boundary) << where;
+    EXPECT_EQ(mesh.get_boundary_faces().size(), boundary.size()) << where;
+    const std::set<std::array<unsigned int, 2>> listed_edges(mesh.get_edges().begin(),
+                                                             mesh.get_edges().end());
+    EXPECT_EQ(listed_edges, edges) << where;
+    EXPECT_EQ(mesh.n_edges(), edges.size()) << where;
+    for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
+    {
+      EXPECT_EQ(mesh.is_boundary_vertex(v), on_boundary[v]) << where << ", vertex " << v;
+      std::vector<unsigned int> star;
+      for (unsigned int t = 0; t < mesh.n_tets(); ++t)
+        if (std::count(mesh.tet(t).begin(), mesh.tet(t).end(), v) != 0)
+          star.push_back(t);
+      std::vector<unsigned int> listed_star(mesh.tets_of_vertex(v).begin(),
+                                            mesh.tets_of_vertex(v).end());
+      std::sort(listed_star.begin(), listed_star.end());
+      EXPECT_EQ(listed_star, star) << where << ", vertex " << v;
+    }
+  }
+} // namespace
+
+
+TEST(TetMesh, RandomLocalReplacementsMatchTheReferenceAndARebuild)
+{
+  // A box of 4 x 4 x 4 cubes, six tetrahedra each, changed by random local
+  // replacements: cells put back in another order and with their vertices rotated,
+  // cells split at their centroid, edges split at their midpoint, cracks that give
+  // part of a vertex's star a copy of the vertex, and cracks closed again (the new
+  // cells then join surviving cells across former boundary faces). After each one
+  // the neighbours and the boundary face list, in order, are those of the plain
+  // reference, and neighbours, boundary faces, edges, stars and boundary flags those
+  // of the cells alone.
+  const unsigned int  n = 4;
+  std::vector<Point3> points;
+  const auto          index = [n](unsigned int i, unsigned int j, unsigned int k)
+  { return (k * (n + 1) + j) * (n + 1) + i; };
+  for (unsigned int k = 0; k <= n; ++k)
+    for (unsigned int j = 0; j <= n; ++j)
+      for (unsigned int i = 0; i <= n; ++i)
+        points.push_back({double(i), double(j), double(k)});
+  std::vector<Tet>                                 cells;
+  const std::array<std::array<unsigned int, 3>, 6> paths = {
+    {{{0, 1, 2}}, {{0, 2, 1}}, {{1, 0, 2}}, {{1, 2, 0}}, {{2, 0, 1}}, {{2, 1, 0}}}};
+  for (unsigned int k = 0; k < n; ++k)
+    for (unsigned int j = 0; j < n; ++j)
+      for (unsigned int i = 0; i < n; ++i)
+        for (const auto &path : paths)
+        {
+          std::array<unsigned int, 3> c{{i, j, k}};
+          Tet                         t;
+          t[0] = index(c[0], c[1], c[2]);
+          for (unsigned int s = 0; s < 3; ++s)
+          {
+            ++c[path[s]];
+            t[s + 1] = index(c[0], c[1], c[2]);
+          }
+          cells.push_back(t);
+        }
+  TetMesh mesh(points, cells, "box");
+  mesh.enable_local_updates();
+  mesh.reserve(2 * mesh.n_vertices(), 4 * mesh.n_tets());
+
+  std::mt19937 rng(20261122);
+  const auto   pick = [&](const std::size_t size)
+  {
+    return static_cast<unsigned int>(
+      std::uniform_int_distribution<std::size_t>(0, size - 1)(rng));
+  };
+  const auto cells_with = [&](const std::vector<unsigned int> &vs)
+  {
+    std::vector<unsigned int> out;
+    for (unsigned int t = 0; t < mesh.n_tets(); ++t)
+    {
+      bool all = true;
+      for (const unsigned int v : vs)
+        all = all && std::count(mesh.tet(t).begin(), mesh.tet(t).end(), v) != 0;
+      if (all)
+        out.push_back(t);
+    }
+    return out;
+  };
+  const auto replaced = [](Tet cell, const unsigned int from, const unsigned int to)
+  {
+    std::replace(cell.begin(), cell.end(), from, to);
+    return cell;
+  };
+  const auto midpoint = [&](const unsigned int a, const unsigned int b)
+  {
+    const Point3 &x = mesh.vertex(a), &y = mesh.vertex(b);
+    return Point3{{(x[0] + y[0]) / 2, (x[1] + y[1]) / 2, (x[2] + y[2]) / 2}};
+  };
+  std::vector<std::array<unsigned int, 2>> cracks; // (vertex, its copy)
+  unsigned int                             done = 0, closed = 0;
+  for (unsigned int step = 0; step < 120; ++step)
+  {
+    const unsigned int        kind = pick(5);
+    std::vector<unsigned int> removed;
+    std::vector<Tet>          added;
+    unsigned int              new_vertex = invalid_index, cracked = 0, closing = 0;
+    Point3                    new_point{};
+    const unsigned int        t = pick(mesh.n_tets());
+    // In every kind a face between a removed and a surviving cell is a face of a new
+    // cell too (the caller's guarantee).
+    if (kind == 0)
+    {
+      // A cell and its neighbours put back, each with an even permutation of its
+      // vertices (the same orientation, other local faces).
+      removed.push_back(t);
+      for (unsigned int f = 0; f < 4; ++f)
+        if (mesh.neighbor(t, f) != invalid_index)
+          removed.push_back(mesh.neighbor(t, f));
+      for (const unsigned int r : removed)
+      {
+        const Tet &c = mesh.tet(r);
+        added.push_back(pick(2) == 0 ? Tet{{c[1], c[2], c[0], c[3]}}
+                                     : Tet{{c[2], c[3], c[0], c[1]}});
+      }
+    }
+    else if (kind == 1)
+    {
+      // Split at the centroid: child i has the centroid in place of vertex i.
+      const Tet &c = mesh.tet(t);
+      for (unsigned int d = 0; d < 3; ++d)
+        new_point[d] = (mesh.vertex(c[0])[d] + mesh.vertex(c[1])[d] + mesh.vertex(c[2])[d]
+                        + mesh.vertex(c[3])[d])
+                       / 4;
+      new_vertex = mesh.n_vertices();
+      removed.push_back(t);
+      for (unsigned int i = 0; i < 4; ++i)
+        added.push_back(replaced(c, c[i], new_vertex));
+    }
+    else if (kind == 2)
+    {
+      // Split an edge of t at its midpoint, in every cell around it.
+      const auto  &e = TetMesh::edge_vertices[pick(6)];
+      unsigned int a = mesh.tet(t)[e[0]], b = mesh.tet(t)[e[1]];
+      new_point  = midpoint(a, b);
+      new_vertex = mesh.n_vertices();
+      removed    = cells_with({a, b});
+      for (const unsigned int r : removed)
+      {
+        added.push_back(replaced(mesh.tet(r), a, new_vertex));
+        added.push_back(replaced(mesh.tet(r), b, new_vertex));
+      }
+    }
+    else if (kind == 3)
+    {
+      // A crack: the cells around a vertex on one side of a plane through it take a
+      // copy of the vertex. The whole star is replaced, as the cutter replaces the
+      // cells on both sides: a surviving cell never loses a neighbour.
+      const unsigned int v    = mesh.tet(t)[pick(4)];
+      const unsigned int axis = pick(3);
+      cracked                 = v;
+      new_point               = mesh.vertex(v);
+      new_vertex              = mesh.n_vertices();
+      unsigned int moved      = 0;
+      removed                 = cells_with({v});
+      for (const unsigned int r : removed)
+      {
+        double centre = 0;
+        for (const unsigned int w : mesh.tet(r))
+          centre += mesh.vertex(w)[axis] / 4;
+        const bool below = centre < mesh.vertex(v)[axis];
+        added.push_back(below ? replaced(mesh.tet(r), v, new_vertex) : mesh.tet(r));
+        moved += below ? 1 : 0;
+      }
+      if (moved == 0 || moved == removed.size())
+        removed.clear(); // no crack
+    }
+    else if (!cracks.empty())
+    {
+      // Close a crack: the copy's cells take the vertex back.
+      closing              = pick(cracks.size());
+      const auto [v, copy] = cracks[closing];
+      for (const unsigned int r : cells_with({copy}))
+      {
+        removed.push_back(r);
+        added.push_back(replaced(mesh.tet(r), copy, v));
+      }
+    }
+    if (removed.empty() || !stays_manifold(mesh.get_tets(), removed, added))
+      continue;
+    std::shuffle(removed.begin(), removed.end(), rng);
+    std::shuffle(added.begin(), added.end(), rng);
+    std::vector<std::array<unsigned int, 4>> face_ids;
+    for (std::size_t k = 0; k < added.size(); ++k)
+      face_ids.push_back({{pick(5), pick(5), pick(5), pick(5)}});
+    if (new_vertex != invalid_index)
+    {
+      ASSERT_EQ(mesh.add_vertex(new_point), new_vertex);
+    }
+    if (kind == 3)
+      cracks.push_back({{cracked, new_vertex}});
+    if (kind == 4)
+      cracks.erase(cracks.begin() + closing);
+
+    ReferenceMesh             reference(mesh);
+    const auto                edges_before = mesh.get_edges();
+    std::vector<unsigned int> ids;
+    TetMesh::EdgeUpdate       update;
+    mesh.replace_tets(removed, added, face_ids, ids, update);
+    reference.replace(removed, added, face_ids);
+    ++done;
+    const std::string where =
+      "step " + std::to_string(step) + " (kind " + std::to_string(kind) + ")";
+    ASSERT_EQ(mesh.get_tets(), reference.tets) << where;
+    for (unsigned int c = 0; c < mesh.n_tets(); ++c)
+      for (unsigned int f = 0; f < 4; ++f)
+        ASSERT_EQ(mesh.neighbor(c, f), reference.neighbors[c][f]) << where;
+    ASSERT_EQ(mesh.get_boundary_faces().size(), reference.boundary.size()) << where;
+    for (std::size_t i = 0; i < reference.boundary.size(); ++i)
+    {
+      EXPECT_EQ(mesh.get_boundary_faces()[i].tet, reference.boundary[i].tet) << where;
+      EXPECT_EQ(mesh.get_boundary_faces()[i].face, reference.boundary[i].face) << where;
+      EXPECT_EQ(mesh.get_boundary_faces()[i].boundary_id,
+                reference.boundary[i].boundary_id)
+        << where;
+    }
+    // The edge update replayed on the old edge list gives the new one where it
+    // names a surviving edge: a surviving edge keeps its spring.
+    std::vector<std::array<unsigned int, 2>> replay = edges_before;
+    replay.resize(edges_before.size() + update.n_added, {{invalid_index, invalid_index}});
+    for (const auto &[to, from] : update.moves)
+    {
+      replay[to] = replay[from];
+      replay.pop_back();
+    }
+    ASSERT_EQ(replay.size(), mesh.n_edges()) << where;
+    for (unsigned int e = 0; e < replay.size(); ++e)
+      if (replay[e][0] != invalid_index)
+      {
+        EXPECT_EQ(replay[e], mesh.get_edges()[e]) << where;
+      }
+    expect_connectivity_from_scratch(mesh, where);
+    if (kind == 4)
+      ++closed;
+  }
+  EXPECT_GT(done, 60u);
+  EXPECT_GT(closed, 5u);
 }

@@ -162,6 +162,49 @@ TEST(VertexStars, MatchesAVectorPerVertexUnderRandomUpdates)
 }
 
 
+TEST(VertexStars, ErasingMarkedCellsAtOnceGivesTheStarOfErasingThemOneByOne)
+{
+  // Stars of every size around the in-place limit of 15 cells (slot of 16 words),
+  // with random subsets marked: in place, overflowing and staying so, and
+  // overflowing and coming back in place.
+  std::mt19937 random(11);
+  for (unsigned int trial = 0; trial < 400; ++trial)
+  {
+    VertexStars               at_once(16), one_by_one(16);
+    const unsigned int        n = random() % 40;
+    std::vector<unsigned int> cells, kept;
+    at_once.resize(2);
+    one_by_one.resize(2);
+    for (unsigned int i = 0; i < n; ++i)
+    {
+      const unsigned int t = random() % 1000;
+      if (std::find(cells.begin(), cells.end(), t) != cells.end())
+        continue;
+      cells.push_back(t);
+      at_once.insert(1, t);
+      one_by_one.insert(1, t);
+      at_once.insert(0, t); // a neighbouring star that must stay as it is
+    }
+    std::vector<bool> marked(1000, false);
+    for (const unsigned int t : cells)
+      marked[t] = random() % 3 == 0;
+    for (const unsigned int t : cells)
+      if (marked[t])
+        one_by_one.erase(1, t);
+      else
+        kept.push_back(t);
+    at_once.erase_marked(1, [&](const unsigned int t) { return marked[t]; });
+    expect_star(at_once, 1, kept);
+    expect_star(one_by_one, 1, kept);
+    expect_star(at_once, 0, cells);
+    // The star still grows and shrinks as any other.
+    at_once.insert(1, 1000);
+    kept.push_back(1000);
+    expect_star(at_once, 1, kept);
+  }
+}
+
+
 TEST(VertexStars, RefusesASlotThatIsNotWholeCacheLines)
 {
   EXPECT_THROW(VertexStars(0), Error);

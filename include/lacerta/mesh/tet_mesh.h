@@ -254,12 +254,14 @@ namespace lacerta::mesh
       const unsigned int u = from_a ? a : b, w = from_a ? b : a;
       for (const unsigned int t : vertex_tets[u])
       {
-        const Tet   &q = tets[t];
-        unsigned int j = 0;
-        while (j < 4 && q[j] != w)
-          ++j;
-        if (j == 4)
+        const Tet &q = tets[t];
+        // Without short-circuits: which cells of the star hold w follows no pattern
+        // a branch predictor learns.
+        if (!((q[0] == w) | (q[1] == w) | (q[2] == w) | (q[3] == w)))
           continue;
+        unsigned int j = 0;
+        while (q[j] != w)
+          ++j;
         unsigned int i = 0;
         while (q[i] != u)
           ++i;
@@ -322,14 +324,18 @@ namespace lacerta::mesh
   private:
     /// Working arrays of replace_tets(), kept so that an update allocates nothing
     /// once they have grown; `vertex_stamp` (per vertex) and `edge_stamp` (per edge id)
-    /// mark the vertices and old edges seen by the current update.
+    /// mark the vertices and old edges seen by the current update, `fresh_stamp` the
+    /// vertices only new tets hold, `tet_stamp` the removed tets.
     struct ReplaceScratch
     {
       std::vector<std::array<unsigned int, 6>> new_edge_ids;
       /// Open-addressing table of the edges of the new tets seen so far: (a, b, id).
       std::vector<std::array<unsigned int, 3>> created;
+      /// Open-addressing table of faces by sorted vertex triple: (a, b, c, 4 t + f).
+      std::vector<std::array<unsigned int, 4>> faces;
       std::vector<std::array<unsigned int, 3>> old_edges;
       std::vector<unsigned int>                dead, refresh, vertex_stamp, edge_stamp;
+      std::vector<unsigned int>                fresh_stamp, tet_stamp;
       unsigned int                             stamp = 0;
     };
 

@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -153,7 +154,49 @@ namespace lacerta::mesh
     void
     erase(unsigned int v, unsigned int t);
 
+    /**
+     * Removes the cells for which @p marked (t) is true from the star of vertex @p v,
+     * keeping the order of the others: the same star as erase() of each of them, in
+     * one pass.
+     */
+    template <typename Marked>
+    void
+    erase_marked(const unsigned int v, Marked &&marked)
+    {
+      unsigned int *s = slot(v);
+      if (s[0] > slot_words - 1)
+      {
+        erase_marked_overflowing(v, marked);
+        return;
+      }
+      // Every id is copied and the write position advances past the kept ones only:
+      // no branch on which cells are marked, which follows no pattern.
+      unsigned int *const ids  = s + 1;
+      unsigned int        kept = 0;
+      for (unsigned int i = 0; i < s[0]; ++i)
+      {
+        const unsigned int t = ids[i];
+        ids[kept]            = t;
+        kept += marked(t) ? 0 : 1;
+      }
+      s[0] = kept;
+    }
+
   private:
+    /// erase_marked() for a star in the overflow list.
+    template <typename Marked>
+    void
+    erase_marked_overflowing(const unsigned int v, Marked &marked)
+    {
+      std::vector<unsigned int> &list = overflow[slot(v)[1]];
+      list.erase(std::remove_if(list.begin(), list.end(), marked), list.end());
+      shrink_overflowing(v);
+    }
+
+    /// Moves the star of @p v back in place if its overflow list fits there again.
+    void
+    shrink_overflowing(unsigned int v);
+
     /// One cache line; a slot is slot_words / 16 of them.
     struct alignas(64) Line
     {
