@@ -138,6 +138,7 @@ namespace lacerta::cut
     on_surface.reserve(room(mesh.n_vertices()));
     joined_at.reserve(room(mesh.n_vertices()));
     swept.reserve(room(mesh.n_vertices()));
+    swept_at.reserve(room(mesh.n_vertices()));
     crossing_pending.reserve(room(mesh.n_vertices()));
     edge_scratch.reserve(room(mesh.n_edges()));
     edge_stamp.reserve(room(mesh.n_edges()));
@@ -183,7 +184,6 @@ namespace lacerta::cut
     stroke_has_cut = false;
     after_corner   = false;
     corner_pending = false;
-    anchors.clear();
   }
 
 
@@ -367,8 +367,6 @@ namespace lacerta::cut
     // (and, crossing the crack's cells diagonally, often nothing at all, leaving the
     // corner uncut): the front is first brought to the corner, without waiting, so
     // that the next side starts from the corner line.
-    measure_front_drift();
-    const Point front_before = front.tail;
     // A catch-up that was postponed is retried towards the same corner: towards where
     // the blade was at the next sweep instead, the front would cut a chord across it.
     const auto  mid = [](const Blade &b) { return scale(0.5, add(b.tail, b.head)); };
@@ -391,40 +389,10 @@ namespace lacerta::cut
       }
     }
     sweep_once(end, statistics);
-    // The front's tissue: the cells the blade is in where the front was applied.
-    if (!(front.tail == front_before))
-      anchor_front();
     // The first sweep of the new side that advances the front ends the corner.
     if (front.tail == end.tail)
       after_corner = false;
     last_end = end;
-  }
-
-
-  void
-  Cutter::anchor_front()
-  {
-    anchors.clear();
-    for (const unsigned int t : active)
-      for (const unsigned int v : mesh.tet(t))
-        anchors.push_back(v);
-    std::sort(anchors.begin(), anchors.end());
-    anchors.erase(std::unique(anchors.begin(), anchors.end()), anchors.end());
-    anchored_at.resize(anchors.size());
-    for (std::size_t i = 0; i < anchors.size(); ++i)
-      anchored_at[i] = position(anchors[i]);
-  }
-
-
-  void
-  Cutter::measure_front_drift()
-  {
-    front_drift = Point{{0, 0, 0}};
-    if (anchors.empty())
-      return;
-    for (std::size_t i = 0; i < anchors.size(); ++i)
-      front_drift = add(front_drift, sub(position(anchors[i]), anchored_at[i]));
-    front_drift = scale(1.0 / anchors.size(), front_drift);
   }
 
 
@@ -473,18 +441,6 @@ namespace lacerta::cut
       surface.start_dir = scale(-1, surface.start_dir);
     const double eps = parameters.snap_fraction;
     start_reach      = (stroke_has_cut ? start_tolerance : 1.0) * typical_edge;
-    // The front was applied where the blade was then; the tissue has moved since,
-    // and the crack's tip with it. Where the tip fell back (against the motion), the
-    // plane reaches back by as much, or the strip between the tip and the start line
-    // would stay uncut and bridge the sides. Not at a corner, where the part behind
-    // the start line belongs to the other side.
-    if (stroke_has_cut && !catching_up && !after_corner)
-    {
-      const double back = -dot(surface.start_dir, front_drift);
-      if (back > 0)
-        start_reach =
-          std::max(start_reach, std::min(back + eps * typical_edge, typical_edge));
-    }
 
     const auto t_start = Clock::now();
     lap_start          = t_start;
@@ -693,6 +649,7 @@ namespace lacerta::cut
     if (on_surface.size() < mesh.n_vertices())
       on_surface.resize(mesh.n_vertices(), 0);
     swept.resize(mesh.n_vertices(), 0);
+    swept_at.resize(mesh.n_vertices());
     crossing_pending.resize(mesh.n_vertices(), 0);
   }
 
@@ -725,9 +682,19 @@ namespace lacerta::cut
     // as the stretched tissue relaxes, by several millimetres in square_hole), so
     // where it is now says little about whether a plane that continues the cut holds
     // it. Whether it is on the plane, and reached, is judged where it joined the crack.
+    // The same holds for a fresh vertex an earlier sweep of the stroke put on the
+    // plane and swept (a postponed sweep, or one whose patch waited): it stays
+    // reached, and is judged where it was swept. Judged where it is now, the tissue
+    // carried it off the plane (square_hole's third side: 0.9 mm, beyond ε of an edge)
+    // while the front waited, and the sweep that finally applied put it on one side
+    // behind its start line, where no crossing is cut, next to cells the earlier
+    // sweeps had split with it on the plane: the cell between stayed whole and
+    // bridged the sides.
     const double tolerance = parameters.snap_fraction * typical_edge;
-    Point        at        = on_surface[v] ? joined_at[v] : x;
-    bool         on_crack  = on_surface[v] && std::abs(surface.distance(at)) <= tolerance;
+    const bool   was_swept = !on_surface[v] && swept[v] == stroke;
+    Point        at        = on_surface[v] ? joined_at[v] : was_swept ? swept_at[v] : x;
+    bool         on_crack =
+      (on_surface[v] || was_swept) && std::abs(surface.distance(at)) <= tolerance;
     // Where the flap twists (square_hole's fourth side crossing the first side's
     // crack), neither place puts a crack vertex on the plane: it is then judged in
     // the rest frame of the tissue the blade is in, where crack vertices never move
@@ -875,7 +842,12 @@ namespace lacerta::cut
         if (!s.on_plane)
           return;
         if (s.reached && !on_surface[v])
+        {
+          // Where it was first swept: later sweeps judge it there (vertex_data()).
+          if (swept[v] != stroke)
+            swept_at[v] = position(v);
           swept[v] = stroke;
+        }
         if (!s.reached)
           vertex_scratch[root(v)].group_reached = false;
       };

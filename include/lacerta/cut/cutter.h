@@ -337,20 +337,6 @@ namespace lacerta::cut
     /// The corner the front is being brought to, while that has not succeeded yet.
     Blade corner;
     bool  corner_pending = false;
-    /// Vertices around the crack front when it was applied, and where they were then:
-    /// the crack tip moves with the tissue, the stored front does not.
-    std::vector<unsigned int> anchors;
-    std::vector<Point>        anchored_at;
-    /// The mean motion of the anchors since the front was applied.
-    Point front_drift{{0, 0, 0}};
-
-    /// Takes the vertices of the active cells as the front's anchors.
-    void
-    anchor_front();
-
-    /// Sets `front_drift` from the anchors.
-    void
-    measure_front_drift();
     /// Typical edge length at rest (median), for the sub-division when nothing is active.
     double typical_edge = 0;
     /// The current stroke (from entering the tissue to leaving it), from 1, and
@@ -373,6 +359,9 @@ namespace lacerta::cut
     /// Stroke in which a vertex on the plane was swept by the blade (its patch opens
     /// when all of it is swept).
     std::vector<unsigned int> swept;
+    /// Where each swept vertex was (world) when a sweep of the stroke first swept it
+    /// on the plane (later sweeps judge it there).
+    std::vector<Point> swept_at;
     /// Stroke in which a vertex of the crack lay on the plane ahead of the front (a
     /// later sweep that reaches it re-splits its star).
     std::vector<unsigned int> crossing_pending;
