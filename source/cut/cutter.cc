@@ -154,7 +154,11 @@ namespace lacerta::cut
                      lengths.end());
     typical_edge = lengths[lengths.size() / 2];
     tree.build(mesh, system.position.data());
-    constant_density        = physics::constant_value(density);
+    constant_density = physics::constant_value(density);
+    if (constant_density)
+      constant_density_mass.emplace(*constant_density);
+    else
+      constant_density_mass.reset();
     constant_youngs_modulus = physics::constant_value(youngs_modulus);
     tet_stamp.assign(mesh.n_tets(), 0);
     edge_stamp.assign(mesh.n_edges(), 0);
@@ -1120,8 +1124,7 @@ namespace lacerta::cut
       if (constant_density && constant_youngs_modulus)
       {
         const double volume = mesh.volume(t);
-        return {physics::constant_density_mass_contributions(volume, *constant_density),
-                *constant_youngs_modulus * volume};
+        return {(*constant_density_mass)(volume), *constant_youngs_modulus * volume};
       }
       return {constant_density
                 ? physics::tet_mass_contributions(mesh, t, *constant_density)

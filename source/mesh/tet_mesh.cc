@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <numeric>
 
@@ -62,6 +63,19 @@ namespace lacerta::mesh
     lesser(const unsigned int x, const unsigned int y)
     {
       return y ^ ((x ^ y) & (0u - static_cast<unsigned int>(x < y)));
+    }
+
+
+    /// Sets @p table to @p size entries of invalid_index (every byte 0xff) in one
+    /// memset: assign() writes the entries' ids one at a time, and the update's
+    /// tables are cleared at every update.
+    template <std::size_t n>
+    void
+    clear_table(std::vector<std::array<unsigned int, n>> &table, const std::size_t size)
+    {
+      static_assert(invalid_index == 0xffffffffu);
+      table.resize(size);
+      std::memset(static_cast<void *>(table.data()), 0xff, size * sizeof(table[0]));
     }
 
 
@@ -467,6 +481,10 @@ namespace lacerta::mesh
     boundary_slot.assign(4 * tets.size(), invalid_index);
     for (unsigned int i = 0; i < boundary_faces.size(); ++i)
       boundary_slot[4 * boundary_faces[i].tet + boundary_faces[i].face] = i;
+    edge_uses.assign(edges.size(), 0);
+    for (const auto &ids : tet_edge_ids)
+      for (const unsigned int id : ids)
+        ++edge_uses[id];
   }
 
 
@@ -493,6 +511,7 @@ namespace lacerta::mesh
       const std::size_t n_edges = std::size_t(growth * double(edges.size()));
       replace_scratch.vertex_stamp.reserve(n_vertices);
       replace_scratch.vertex_stamp.resize(vertices.size(), 0);
+      edge_uses.reserve(n_edges);
       replace_scratch.edge_stamp.reserve(n_edges);
       replace_scratch.edge_stamp.resize(edges.size(), 0);
       replace_scratch.fresh_stamp.reserve(n_vertices);
@@ -600,7 +619,7 @@ namespace lacerta::mesh
     while (table_size < 8 * (added.size() + removed.size()))
       table_size *= 2;
     auto &created = scratch.created;
-    created.assign(table_size, {{invalid_index, invalid_index, invalid_index}});
+    clear_table(created, table_size);
     // The slot of edge (a, b): its entry, or the empty slot where it goes.
     const auto find_created = [&](const unsigned int a,
                                   const unsigned int b) -> std::array<unsigned int, 3> &
@@ -674,6 +693,7 @@ namespace lacerta::mesh
     auto &old_edges = scratch.old_edges;
     old_edges.clear();
     scratch.edge_stamp.resize(edges.size(), 0);
+    edge_uses.resize(edges.size(), 0);
     for (const auto &ids : new_edge_ids)
       for (const unsigned int id : ids)
         scratch.edge_stamp[id] = scratch.stamp;
@@ -684,8 +704,7 @@ namespace lacerta::mesh
     while (face_table_size <= 4 * (added.size() + removed.size()))
       face_table_size *= 2;
     auto &face_table = scratch.faces;
-    face_table.assign(face_table_size,
-                      {{invalid_index, invalid_index, invalid_index, invalid_index}});
+    clear_table(face_table, face_table_size);
     const auto find_face = [&](const FaceKey &key) -> std::array<unsigned int, 4> &
     {
       std::size_t h = (std::size_t(key[0]) * 0x9E3779B97F4A7C15ULL
@@ -712,6 +731,7 @@ namespace lacerta::mesh
       for (unsigned int e = 0; e < 6; ++e)
       {
         const unsigned int id = tet_edge_ids[r][e];
+        --edge_uses[id];
         if (scratch.edge_stamp[id] == scratch.stamp)
           continue;
         scratch.edge_stamp[id] = scratch.stamp;
@@ -762,6 +782,8 @@ namespace lacerta::mesh
       added_ids[k]            = slot;
       tets[slot]              = added[k];
       tet_edge_ids[slot]      = new_edge_ids[k];
+      for (const unsigned int id : new_edge_ids[k])
+        ++edge_uses[id];
       for (const unsigned int v : added[k])
       {
         // A vertex whose star is empty now is held by new cells only.
@@ -850,11 +872,13 @@ namespace lacerta::mesh
     }
 
     // Retire the edges no tetrahedron uses any more, largest id first, so that the
-    // last slot moved into a hole is always a live edge.
+    // last slot moved into a hole is always a live edge. The counts of uses answer
+    // without searching a star for a cell with both ends (a dead edge's search read
+    // the whole star).
     auto &dead = scratch.dead;
     dead.clear();
     for (const auto &e : old_edges)
-      if (find_edge(e[0], e[1]) == invalid_index)
+      if (edge_uses[e[2]] == 0)
         dead.push_back(e[2]);
     std::sort(dead.rbegin(), dead.rend());
     for (const unsigned int r : dead)
@@ -862,7 +886,8 @@ namespace lacerta::mesh
       const unsigned int last = static_cast<unsigned int>(edges.size() - 1);
       if (r != last)
       {
-        edges[r] = edges[last];
+        edges[r]     = edges[last];
+        edge_uses[r] = edge_uses[last];
         // Every cell with both ends holds the moved edge, at one local edge.
         visit_tets_with_edge(edges[r][0],
                              edges[r][1],
@@ -874,6 +899,7 @@ namespace lacerta::mesh
       }
       update.moves.push_back({{r, last}});
       edges.pop_back();
+      edge_uses.pop_back();
     }
 
     // Boundary flags of every vertex involved, once each.

@@ -1,3 +1,4 @@
+#include <lacerta/base/exceptions.h>
 #include <lacerta/physics/assembly.h>
 
 #include <deal.II/base/function.h>
@@ -93,16 +94,42 @@ namespace lacerta::physics
   std::array<double, 4>
   constant_density_mass_contributions(const double volume, const double sigma)
   {
-    // The same sums in the same order as the general tet_mass_contributions() with
-    // σ(x) = sigma, so that the contributions are bit-identical; only the quadrature
-    // points and the calls of the density are saved.
+    return ConstantDensityMass(sigma)(volume);
+  }
+
+
+  ConstantDensityMass::ConstantDensityMass(const double sigma)
+  {
     static const BarycentricRule rule;
-    std::array<double, 4>        m = {{0, 0, 0, 0}};
-    for (unsigned int q = 0; q < rule.weights.size(); ++q)
+    if (rule.weights.size() != n_points)
+      throw_error("ConstantDensityMass: the quadrature rule has ",
+                  rule.weights.size(),
+                  " points instead of ",
+                  n_points,
+                  ".");
+    for (unsigned int q = 0; q < n_points; ++q)
     {
-      const double jxw = rule.weights[q] * volume;
+      weights[q] = rule.weights[q];
       for (unsigned int i = 0; i < 4; ++i)
-        m[i] += sigma * rule.coordinates[q][i] * jxw;
+        scaled_coordinates[q][i] = sigma * rule.coordinates[q][i];
+    }
+  }
+
+
+  std::array<double, 4>
+  ConstantDensityMass::operator()(const double volume) const
+  {
+    // The same sums in the same order as the general tet_mass_contributions() with
+    // σ(x) = sigma, so that the contributions are bit-identical: its term
+    // sigma * c_i * jxw is (sigma * c_i) * jxw, and only the first product is the
+    // same for every cell. The quadrature points and the calls of the density are
+    // saved too.
+    std::array<double, 4> m = {{0, 0, 0, 0}};
+    for (unsigned int q = 0; q < n_points; ++q)
+    {
+      const double jxw = weights[q] * volume;
+      for (unsigned int i = 0; i < 4; ++i)
+        m[i] += scaled_coordinates[q][i] * jxw;
     }
     return m;
   }

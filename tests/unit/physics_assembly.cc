@@ -58,16 +58,20 @@ TEST(Assembly, ConstantDensityShortcutGivesTheSameMassesToTheLastBit)
   EXPECT_EQ(*sigma, 1234.5);
   const auto modulus = physics::constant_value(youngs);
   ASSERT_TRUE(modulus.has_value());
+  // One object for all the cells, as the cutter keeps it.
+  const physics::ConstantDensityMass for_all_cells(*sigma);
   for (unsigned int t = 0; t < mesh.n_tets(); ++t)
   {
     const auto by_function = physics::tet_mass_contributions(mesh, t, density);
     const auto by_value    = physics::tet_mass_contributions(mesh, t, *sigma);
     const auto by_volume =
       physics::constant_density_mass_contributions(mesh.volume(t), *sigma);
+    const auto by_object = for_all_cells(mesh.volume(t));
     for (unsigned int i = 0; i < 4; ++i)
     {
       EXPECT_EQ(by_function[i], by_value[i]) << "tet " << t << " vertex " << i;
       EXPECT_EQ(by_function[i], by_volume[i]) << "tet " << t << " vertex " << i;
+      EXPECT_EQ(by_function[i], by_object[i]) << "tet " << t << " vertex " << i;
     }
     EXPECT_EQ(physics::tet_stiffness_factor(mesh, t, youngs), *modulus * mesh.volume(t))
       << "tet " << t;

@@ -11,6 +11,7 @@
 #include <lacerta/cut/split_table.h>
 #include <lacerta/cut/tool.h>
 #include <lacerta/mesh/tet_mesh.h>
+#include <lacerta/physics/assembly.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -321,6 +322,8 @@ namespace lacerta::cut
     double                            &integral_of_density;
     /// The density's value if it is constant (physics::constant_value()).
     std::optional<double> constant_density;
+    /// The mass contributions for the constant density, if it is constant.
+    std::optional<physics::ConstantDensityMass> constant_density_mass;
     /// Young's modulus if it is constant (physics::constant_value()).
     std::optional<double> constant_youngs_modulus;
     Parameters            parameters;

@@ -351,6 +351,8 @@ namespace lacerta::mesh
     VertexStars vertex_tets;
     /// For local updates: index into boundary_faces of face 4 t + f, or invalid_index.
     std::vector<unsigned int> boundary_slot;
+    /// For local updates: the number of tetrahedra that hold each edge.
+    std::vector<unsigned int> edge_uses;
 
     /// Rebuilds neighbours, boundary faces, edges and boundary flags from the tets.
     void

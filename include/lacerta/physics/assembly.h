@@ -67,6 +67,31 @@ namespace lacerta::physics
   constant_density_mass_contributions(double volume, double sigma);
 
   /**
+   * constant_density_mass_contributions() for one density @p sigma and many
+   * tetrahedra: the same values to the last bit, with the products of the density and
+   * the quadrature rule's barycentric coordinates formed once.
+   */
+  class ConstantDensityMass
+  {
+  public:
+    /// The contributions for a density that is @p sigma everywhere.
+    explicit ConstantDensityMass(double sigma);
+
+    /// The contributions of a tetrahedron of volume @p volume to its four vertices.
+    std::array<double, 4>
+    operator()(double volume) const;
+
+    /// The number of points of the quadrature rule of compute_masses().
+    static constexpr unsigned int n_points = 8;
+
+  private:
+    /// σ·c_i at every quadrature point.
+    std::array<std::array<double, 4>, n_points> scaled_coordinates;
+    /// The quadrature weights, summing to 1.
+    std::array<double, n_points> weights;
+  };
+
+  /**
    * The value of @p f if it is a scalar dealii::Functions::ConstantFunction or
    * ZeroFunction (so that callers can use the constant-density overload), otherwise
    * nothing.
