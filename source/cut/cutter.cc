@@ -138,7 +138,6 @@ namespace lacerta::cut
     on_surface.reserve(room(mesh.n_vertices()));
     joined_at.reserve(room(mesh.n_vertices()));
     swept.reserve(room(mesh.n_vertices()));
-    swept_at.reserve(room(mesh.n_vertices()));
     crossing_pending.reserve(room(mesh.n_vertices()));
     edge_scratch.reserve(room(mesh.n_edges()));
     edge_stamp.reserve(room(mesh.n_edges()));
@@ -154,9 +153,8 @@ namespace lacerta::cut
                      lengths.end());
     typical_edge = lengths[lengths.size() / 2];
     tree.build(mesh, system.position.data());
-    constant_density = physics::constant_value(density);
-    if (constant_density)
-      constant_density_mass.emplace(*constant_density);
+    if (const auto sigma = physics::constant_value(density))
+      constant_density_mass.emplace(*sigma);
     else
       constant_density_mass.reset();
     constant_youngs_modulus = physics::constant_value(youngs_modulus);
@@ -652,8 +650,9 @@ namespace lacerta::cut
     partial_child.resize(mesh.n_tets(), 0);
     if (on_surface.size() < mesh.n_vertices())
       on_surface.resize(mesh.n_vertices(), 0);
+    if (joined_at.size() < mesh.n_vertices())
+      joined_at.resize(mesh.n_vertices());
     swept.resize(mesh.n_vertices(), 0);
-    swept_at.resize(mesh.n_vertices());
     crossing_pending.resize(mesh.n_vertices(), 0);
   }
 
@@ -696,7 +695,7 @@ namespace lacerta::cut
     // bridged the sides.
     const double tolerance = parameters.snap_fraction * typical_edge;
     const bool   was_swept = !on_surface[v] && swept[v] == stroke;
-    Point        at        = on_surface[v] ? joined_at[v] : was_swept ? swept_at[v] : x;
+    Point        at        = on_surface[v] || was_swept ? joined_at[v] : x;
     bool         on_crack =
       (on_surface[v] || was_swept) && std::abs(surface.distance(at)) <= tolerance;
     // Where the flap twists (square_hole's fourth side crossing the first side's
@@ -849,7 +848,7 @@ namespace lacerta::cut
         {
           // Where it was first swept: later sweeps judge it there (vertex_data()).
           if (swept[v] != stroke)
-            swept_at[v] = position(v);
+            joined_at[v] = position(v);
           swept[v] = stroke;
         }
         if (!s.reached)
@@ -1121,14 +1120,13 @@ namespace lacerta::cut
     };
     const auto cell_terms = [&](const unsigned int t) -> CellTerms
     {
-      if (constant_density && constant_youngs_modulus)
+      if (constant_density_mass && constant_youngs_modulus)
       {
         const double volume = mesh.volume(t);
         return {(*constant_density_mass)(volume), *constant_youngs_modulus * volume};
       }
-      return {constant_density
-                ? physics::tet_mass_contributions(mesh, t, *constant_density)
-                : physics::tet_mass_contributions(mesh, t, density),
+      return {constant_density_mass ? (*constant_density_mass)(mesh.volume(t))
+                                    : physics::tet_mass_contributions(mesh, t, density),
               physics::tet_stiffness_factor(mesh, t, youngs_modulus)};
     };
     for (const unsigned int r : removed)

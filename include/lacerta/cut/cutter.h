@@ -320,9 +320,7 @@ namespace lacerta::cut
     const dealii::Function<3, double> &density;
     const dealii::Function<3, double> &youngs_modulus;
     double                            &integral_of_density;
-    /// The density's value if it is constant (physics::constant_value()).
-    std::optional<double> constant_density;
-    /// The mass contributions for the constant density, if it is constant.
+    /// The mass contributions if the density is constant (physics::constant_value()).
     std::optional<physics::ConstantDensityMass> constant_density_mass;
     /// Young's modulus if it is constant (physics::constant_value()).
     std::optional<double> constant_youngs_modulus;
@@ -356,15 +354,14 @@ namespace lacerta::cut
     /// Vertices on the cut surface of the current stroke (progressive cuts).
     std::vector<std::uint8_t> on_surface;
     std::vector<unsigned int> on_surface_list;
-    /// Where each vertex of the stroke's crack was (world) when it joined the crack.
+    /// Where each vertex of the stroke's crack was (world) when it joined the crack;
+    /// for a vertex a sweep of the stroke swept on the plane but that is not on the
+    /// crack, where it was first swept. Later sweeps judge the vertex there.
     std::vector<Point>                  joined_at;
     std::vector<BoundaryFaceTree::Face> hits;
     /// Stroke in which a vertex on the plane was swept by the blade (its patch opens
     /// when all of it is swept).
     std::vector<unsigned int> swept;
-    /// Where each swept vertex was (world) when a sweep of the stroke first swept it
-    /// on the plane (later sweeps judge it there).
-    std::vector<Point> swept_at;
     /// Stroke in which a vertex of the crack lay on the plane ahead of the front (a
     /// later sweep that reaches it re-splits its star).
     std::vector<unsigned int> crossing_pending;
