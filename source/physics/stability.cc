@@ -54,16 +54,17 @@ namespace lacerta::physics
   } // namespace
 
 
-  FrequencyBound
-  bound_highest_frequency(const ParticleSystem &system)
+  GershgorinTerms
+  gershgorin_terms(const ParticleSystem &system, const double *x)
   {
     const unsigned int                 n       = system.n_particles();
     const SpringSet                   &springs = system.springs;
-    const double                      *x       = system.position.data();
-    std::vector<std::array<double, 6>> diagonal(n, std::array<double, 6>{});
-    std::vector<double>                off_diagonal(n, 0.0);
+    std::vector<std::array<double, 6>> blocks(n, std::array<double, 6>{});
     std::vector<double>                stiffest(n, 0.0);
-    std::vector<unsigned int>          stiffest_spring(n, 0);
+    GershgorinTerms                    terms;
+    terms.diagonal.assign(n, 0.0);
+    terms.coupling.assign(springs.size(), 0.0);
+    terms.stiffest_spring.assign(n, 0);
 
     for (std::size_t s = 0; s < springs.size(); ++s)
     {
@@ -77,43 +78,58 @@ namespace lacerta::physics
       const double k         = springs.stiffness[s];
       const double geometric = k * (1.0 - springs.rest_length[s] / length);
       // K_e = (k - g) n nᵀ + g I, g the geometric stiffness.
-      const std::array<double, 6> block    = {(k - geometric) * d[0] * d[0] + geometric,
-                                              (k - geometric) * d[1] * d[1] + geometric,
-                                              (k - geometric) * d[2] * d[2] + geometric,
-                                              (k - geometric) * d[0] * d[1],
-                                              (k - geometric) * d[0] * d[2],
-                                              (k - geometric) * d[1] * d[2]};
-      const double                norm     = std::max(k, std::abs(geometric));
-      const double                coupling = (system.free[i] > 0 && system.free[j] > 0)
-                                               ? norm / std::sqrt(system.mass[i] * system.mass[j])
-                                               : 0.0;
+      const std::array<double, 6> block = {(k - geometric) * d[0] * d[0] + geometric,
+                                           (k - geometric) * d[1] * d[1] + geometric,
+                                           (k - geometric) * d[2] * d[2] + geometric,
+                                           (k - geometric) * d[0] * d[1],
+                                           (k - geometric) * d[0] * d[2],
+                                           (k - geometric) * d[1] * d[2]};
+      const double                norm  = std::max(k, std::abs(geometric));
+      if (system.free[i] > 0 && system.free[j] > 0)
+        terms.coupling[s] = norm;
       for (const unsigned int p : {i, j})
       {
         for (unsigned int c = 0; c < 6; ++c)
-          diagonal[p][c] += block[c];
-        off_diagonal[p] += coupling;
+          blocks[p][c] += block[c];
         if (norm > stiffest[p])
         {
-          stiffest[p]        = norm;
-          stiffest_spring[p] = s;
+          stiffest[p]              = norm;
+          terms.stiffest_spring[p] = s;
         }
       }
     }
+    for (unsigned int i = 0; i < n; ++i)
+      terms.diagonal[i] = largest_eigenvalue(blocks[i]);
+    return terms;
+  }
+
+
+  FrequencyBound
+  bound_highest_frequency(const ParticleSystem &system)
+  {
+    const unsigned int    n     = system.n_particles();
+    const GershgorinTerms terms = gershgorin_terms(system, system.position.data());
+    std::vector<double>   off_diagonal(n, 0.0);
+    for (std::size_t s = 0; s < system.springs.size(); ++s)
+      if (terms.coupling[s] > 0)
+      {
+        const unsigned int i = system.springs.a[s], j = system.springs.b[s];
+        const double c = terms.coupling[s] / std::sqrt(system.mass[i] * system.mass[j]);
+        off_diagonal[i] += c;
+        off_diagonal[j] += c;
+      }
 
     FrequencyBound bound;
     double         largest = 0;
     for (unsigned int i = 0; i < n; ++i)
       if (system.free[i] > 0 && system.mass[i] > 0)
       {
-        std::array<double, 6> scaled = diagonal[i];
-        for (double &c : scaled)
-          c /= system.mass[i];
-        const double lambda = largest_eigenvalue(scaled) + off_diagonal[i];
+        const double lambda = terms.diagonal[i] / system.mass[i] + off_diagonal[i];
         if (lambda > largest)
         {
           largest        = lambda;
           bound.particle = i;
-          bound.spring   = stiffest_spring[i];
+          bound.spring   = terms.stiffest_spring[i];
         }
       }
     bound.omega = std::sqrt(largest);

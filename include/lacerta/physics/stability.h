@@ -26,8 +26,32 @@ namespace lacerta::physics
   };
 
   /**
+   * The parts of the block Gershgorin bound of bound_highest_frequency() that do not
+   * depend on the masses, for the particles at @p positions (3 per particle): the bound
+   * at a free particle i is diagonal[i] / m_i + Σ_e coupling[e] / sqrt(m_i m_j) over
+   * its springs e = (i, j).
+   */
+  struct GershgorinTerms
+  {
+    /// λ_max(Σ_e K_e) over the springs at each particle.
+    std::vector<double> diagonal;
+    /// ||K_e|| of each spring whose ends are both free, 0 otherwise.
+    std::vector<double> coupling;
+    /// The stiffest spring at each particle.
+    std::vector<unsigned int> stiffest_spring;
+  };
+
+  /**
+   * The mass-independent terms of the Gershgorin bound with the tangent stiffness of
+   * every spring of @p system at @p positions (3 per particle; the rest positions give
+   * the bound of the undeformed system).
+   */
+  GershgorinTerms
+  gershgorin_terms(const ParticleSystem &system, const double *positions);
+
+  /**
    * Bounds the highest eigenvalue of M^-1/2 K M^-1/2 by block Gershgorin over the free
-   * particles: λ ≤ max_i [λ_max(Σ_e K_e / m_i) + Σ_e ||K_e|| / sqrt(m_i m_j)], with the
+   * particles: λ ≤ max_i [λ_max(Σ_e K_e) / m_i + Σ_e ||K_e|| / sqrt(m_i m_j)], with the
    * tangent stiffness of each spring at the current positions,
    * K_e = k n nᵀ + k (1 - L0/L)(I - n nᵀ), whose geometric part matters for strongly
    * compressed springs. Constrained particles do not move and drop out.
