@@ -1422,9 +1422,13 @@ namespace lacerta::cut
       if (vertex_scratch[v].star_stamp == star_stamp && v < crossing_pending.size())
         crossing_pending[v] = 0;
     // A vertex that lost all its cells cannot happen (copies take over whole stars),
-    // but a mass that rounding left a hair below zero would be nonsense: clamp.
+    // but a mass that rounding left a hair below zero would be nonsense: clamp. A mass
+    // further below zero is a particle that gave mass to its neighbours
+    // (physics::MassBalancer) and lost cells since: the balancer raises it again, and
+    // clamping it would add mass.
+    const double rounding = 1e-12 * std::abs(integral_of_density);
     for (const unsigned int v : touched_vertices)
-      if (system.mass[v] < 0)
+      if (system.mass[v] < 0 && system.mass[v] > -rounding)
         system.mass[v] = 0;
     integral_of_density += integral_delta;
 

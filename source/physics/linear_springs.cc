@@ -146,6 +146,14 @@ namespace lacerta::physics
       }
 
       void
+      masses_changed(const ParticleSystem            &system,
+                     const std::vector<unsigned int> &particles) override
+      {
+        for (const unsigned int i : particles)
+          inverse_mass[i] = system.mass[i] > 0 ? 1.0 / system.mass[i] : 0.0;
+      }
+
+      void
       compute_acceleration(const ParticleSystem &system,
                            const double         *x,
                            const double         *v,

@@ -9,6 +9,7 @@ namespace lacerta::physics
       : position(rest_positions)
       , velocity(rest_positions.size(), 0.0)
       , mass(rest_positions.size() / 3, 0.0)
+      , mass_shift(rest_positions.size() / 3, 0.0)
       , free(rest_positions.size() / 3, 1.0)
       , external_force(rest_positions.size(), 0.0)
       , rest(rest_positions)
@@ -35,6 +36,7 @@ namespace lacerta::physics
     position = rest_positions;
     velocity.assign(rest_positions.size(), 0.0);
     mass.assign(rest_positions.size() / 3, 0.0);
+    mass_shift.assign(rest_positions.size() / 3, 0.0);
     free.assign(rest_positions.size() / 3, 1.0);
     external_force.assign(rest_positions.size(), 0.0);
     springs.clear();
@@ -50,6 +52,7 @@ namespace lacerta::physics
     for (std::vector<double> *v : {&position, &velocity, &external_force, &rest})
       v->reserve(3 * std::size_t(n));
     mass.reserve(n);
+    mass_shift.reserve(n);
     free.reserve(n);
   }
 
@@ -69,6 +72,13 @@ namespace lacerta::physics
   }
 
 
+  void
+  ParticleSystem::masses_changed(const std::vector<unsigned int> &particles)
+  {
+    forces->masses_changed(*this, particles);
+  }
+
+
   unsigned int
   ParticleSystem::add_particle(const std::array<double, 3> &rest_x,
                                const std::array<double, 3> &x,
@@ -82,6 +92,7 @@ namespace lacerta::physics
       rest.push_back(rest_x[d]);
     }
     mass.push_back(0.0);
+    mass_shift.push_back(0.0);
     free.push_back(1.0);
     return n_particles() - 1;
   }

@@ -5,6 +5,7 @@
 #include <lacerta/physics/assembly.h>
 #include <lacerta/physics/force_model.h>
 #include <lacerta/physics/integrator.h>
+#include <lacerta/physics/mass_balancer.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/stability.h>
 #include <lacerta/scene/constraint.h>
@@ -650,4 +651,76 @@ TEST(CutCutter, VerticesSweptOnThePlaneStayOnItWhenTheTissueMovesThemOff)
         if (::testing::Test::HasFatalFailure())
           return;
       }
+}
+
+
+TEST(CutCutter, ACutNearAVertexLayerKeepsTheCriticalStepWithMassRedistribution)
+{
+  // The plane y = 0.4825 passes 7 % of an edge (0.25) from the vertex layer y = 0.5,
+  // above the snap fraction: the cells between are thin and their particles light.
+  std::mt19937                rng(3);
+  CutFixture                  f(4, rng, vertical(-0.2, 0.4825));
+  const physics::MassBalancer balancer(*f.system, 3);
+  const double                before = physics::bound_highest_frequency(*f.system).omega;
+  f.stroke({vertical(-0.2, 0.4825), vertical(1.2, 0.4825)}, 8);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  ASSERT_EQ(f.component_volumes().size(), 2u);
+  const double cut = physics::bound_highest_frequency(*f.system).omega;
+  EXPECT_GT(cut, 2 * before);
+
+  const std::vector<double> cut_rows     = test_support::rest_row_bounds(*f.system);
+  const physics::MassBalanceStatistics s = balancer.balance(*f.system);
+  EXPECT_GT(s.raised, 0u);
+  // Every free particle is under the donors' limit but those reported: the particles
+  // whose springs are too stiff for the mass within reach (short edges of fat cells).
+  const std::vector<double> row = test_support::rest_row_bounds(*f.system);
+  const double              limit =
+    physics::MassBalancer::donor_headroom * balancer.target() * (1 + 1e-9);
+  EXPECT_EQ(static_cast<unsigned int>(
+              std::count_if(row.begin(), row.end(), [&](double l) { return l > limit; })),
+            s.unresolved);
+  EXPECT_LT(s.unresolved, f.system->n_particles() / 4);
+  // A particle above the limit only takes mass: the largest row bound never rises.
+  EXPECT_LE(*std::max_element(row.begin(), row.end()),
+            *std::max_element(cut_rows.begin(), cut_rows.end()));
+  f.expect_invariants("after the redistribution");
+
+  // Every piece keeps the mass ∫σ over it: the particles of a piece are those of its
+  // cells (a face-connected component).
+  const unsigned int        n_tets = f.mesh.n_tets();
+  std::vector<unsigned int> piece(n_tets, n_tets);
+  unsigned int              n_pieces = 0;
+  for (unsigned int t = 0; t < n_tets; ++t)
+    if (piece[t] == n_tets)
+    {
+      std::vector<unsigned int> queue = {t};
+      piece[t]                        = n_pieces;
+      while (!queue.empty())
+      {
+        const unsigned int c = queue.back();
+        queue.pop_back();
+        for (unsigned int k = 0; k < 4; ++k)
+          if (const unsigned int d = f.mesh.neighbor(c, k);
+              d != mesh::invalid_index && piece[d] == n_tets)
+          {
+            piece[d] = n_pieces;
+            queue.push_back(d);
+          }
+      }
+      ++n_pieces;
+    }
+  ASSERT_EQ(n_pieces, 2u);
+  std::vector<double> volume(2, 0.0), mass(2, 0.0);
+  std::vector<int>    piece_of_vertex(f.mesh.n_vertices(), -1);
+  for (unsigned int t = 0; t < n_tets; ++t)
+  {
+    volume[piece[t]] += f.mesh.volume(t);
+    for (const unsigned int v : f.mesh.tet(t))
+      piece_of_vertex[v] = static_cast<int>(piece[t]);
+  }
+  for (unsigned int v = 0; v < f.mesh.n_vertices(); ++v)
+    if (piece_of_vertex[v] >= 0)
+      mass[piece_of_vertex[v]] += f.system->mass[v];
+  for (unsigned int p = 0; p < 2; ++p)
+    EXPECT_NEAR(mass[p], 1000.0 * volume[p], 1e-9 * 1000.0) << "piece " << p;
 }

@@ -6,6 +6,7 @@
 #include <lacerta/physics/assembly.h>
 #include <lacerta/physics/force_model.h>
 #include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/stability.h>
 
 #include <deal.II/base/function.h>
 #include <deal.II/grid/grid_generator.h>
@@ -13,6 +14,7 @@
 #include <deal.II/grid/tria.h>
 
 #include <memory>
+#include <vector>
 
 namespace lacerta::test_support
 {
@@ -54,5 +56,25 @@ namespace lacerta::test_support
     system->set_force_model(physics::ForceModelRegistry::create("linear springs"),
                             n_threads);
     return system;
+  }
+
+
+  /// The row Gershgorin bound of M⁻¹K at rest at every free particle,
+  /// (λ_max(Σ_e K_e) + Σ_e ||K_e||) / m_i (0 at a constrained particle), the bound
+  /// physics::MassBalancer keeps under its target.
+  inline std::vector<double>
+  rest_row_bounds(const physics::ParticleSystem &system)
+  {
+    const physics::GershgorinTerms terms =
+      physics::gershgorin_terms(system, system.rest_position().data());
+    std::vector<double> row = terms.diagonal;
+    for (std::size_t s = 0; s < system.springs.size(); ++s)
+    {
+      row[system.springs.a[s]] += terms.coupling[s];
+      row[system.springs.b[s]] += terms.coupling[s];
+    }
+    for (unsigned int i = 0; i < system.n_particles(); ++i)
+      row[i] = system.free[i] > 0 ? row[i] / system.mass[i] : 0.0;
+    return row;
   }
 } // namespace lacerta::test_support

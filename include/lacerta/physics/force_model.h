@@ -8,6 +8,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace lacerta::physics
 {
@@ -40,6 +41,14 @@ namespace lacerta::physics
      */
     virtual void
     initialize(const ParticleSystem &system, unsigned int n_threads) = 0;
+
+    /**
+     * The masses of @p particles changed (nothing else did): whatever the model keeps
+     * of them is updated. Costs O(particles.size()).
+     */
+    virtual void
+    masses_changed(const ParticleSystem            &system,
+                   const std::vector<unsigned int> &particles) = 0;
 
     /**
      * Accelerations: spring forces plus the system's loads and particle damping,

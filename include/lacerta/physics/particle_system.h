@@ -32,6 +32,12 @@ namespace lacerta::physics
     std::vector<double> velocity;
     /// Lumped masses (kg).
     std::vector<double> mass;
+    /**
+     * The part of each mass that physics::MassBalancer moved there from other
+     * particles (kg; sums to zero): `mass - mass_shift` is the lumped ∫σ c_i that the
+     * assembly and the local updates of cuts add and subtract.
+     */
+    std::vector<double> mass_shift;
     /// 1 for a free particle, 0 for one whose motion is prescribed.
     std::vector<double> free;
     /// External forces (N), 3 per particle; set by the scene's force handles.
@@ -95,6 +101,12 @@ namespace lacerta::physics
      */
     void
     refresh_force_model();
+
+    /**
+     * Tells the force model that the masses of @p particles changed (and nothing else).
+     */
+    void
+    masses_changed(const std::vector<unsigned int> &particles);
 
     /**
      * Appends a free particle with rest position @p rest, position @p x, velocity

@@ -18,7 +18,8 @@ namespace lacerta::scene
 namespace lacerta::physics
 {
   class Integrator;
-}
+  class MassBalancer;
+} // namespace lacerta::physics
 namespace lacerta::postprocess
 {
   class Postprocessor;
@@ -97,5 +98,8 @@ namespace lacerta
     std::unique_ptr<scene::Scene>                            scene;
     std::unique_ptr<physics::Integrator>                     integrator;
     std::vector<std::unique_ptr<postprocess::Postprocessor>> postprocessors;
+    /// 'Stability/Mass redistribution': keeps the time step after topology changes,
+    /// or nullptr.
+    std::unique_ptr<physics::MassBalancer> mass_balancer;
   };
 } // namespace lacerta
