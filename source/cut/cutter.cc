@@ -352,10 +352,11 @@ namespace lacerta::cut
     if (statistics.changed)
     {
       const auto t0 = Clock::now();
-      system.refresh_force_model();
+      system.springs_changed(changed_springs);
       statistics.reinit_seconds =
         std::chrono::duration<double>(Clock::now() - t0).count();
     }
+    changed_springs.clear();
     return statistics;
   }
 
@@ -1141,7 +1142,10 @@ namespace lacerta::cut
       }
       const double f = -terms.stiffness_factor;
       for (const unsigned int e : mesh.tet_edges(r))
+      {
         springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
+        changed_springs.push_back(e);
+      }
     }
 
     lap(statistics.physics_seconds);
@@ -1380,6 +1384,7 @@ namespace lacerta::cut
     for (unsigned int i = 0; i < edge_update.n_added; ++i)
     {
       const unsigned int e = static_cast<unsigned int>(springs.size());
+      changed_springs.push_back(e);
       springs.push_back(edges[e][0],
                         edges[e][1],
                         0.0,
@@ -1387,14 +1392,10 @@ namespace lacerta::cut
     }
     for (const auto &[to, from] : edge_update.moves)
     {
-      springs.a[to]           = springs.a[from];
-      springs.b[to]           = springs.b[from];
-      springs.stiffness[to]   = springs.stiffness[from];
-      springs.rest_length[to] = springs.rest_length[from];
-      springs.a.pop_back();
-      springs.b.pop_back();
-      springs.stiffness.pop_back();
-      springs.rest_length.pop_back();
+      // The mesh copied its last edge `from` into slot `to`: so do the springs.
+      Assert(from + 1 == springs.size(), dealii::ExcInternalError());
+      changed_springs.push_back(to);
+      springs.retire(to);
     }
     prepare_scratch();
     for (std::size_t k = 0; k < added_ids.size(); ++k)
@@ -1410,7 +1411,10 @@ namespace lacerta::cut
       }
       const double f = terms.stiffness_factor;
       for (const unsigned int e : mesh.tet_edges(t))
+      {
         springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
+        changed_springs.push_back(e);
+      }
       for (unsigned int f2 = 0; f2 < 4; ++f2)
         if (mesh.neighbor(t, f2) == mesh::invalid_index)
           tree.add_face(mesh, t, f2);

@@ -9,6 +9,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -73,6 +74,16 @@ namespace lacerta::physics
      * ends) and the springs that cross into another range (writing only its own end).
      * Crossing springs are thus evaluated twice, but no thread ever writes another's
      * memory: no atomics, no locks, no reduction.
+     *
+     * Each range's inner and crossing springs are a segment of their own, kept in the
+     * order of the system's springs, and every system spring knows which segments hold
+     * its copies, so that a cut updates only the springs it changed (springs_changed()):
+     * a copy whose segment stays is rewritten in place (found by bisection), one that
+     * changes range is moved, removed springs are the last ones. The evaluation then
+     * sums every particle's forces in the order a model made afresh on the same ranges
+     * would: on one range the forces are those of initialize() to the last bit. New
+     * particles join the last range; when the ranges' loads drift apart by more than a
+     * quarter of the mean, the partition is made again.
      */
     class LinearSprings : public ForceModel
     {
@@ -85,6 +96,7 @@ namespace lacerta::physics
       void
       initialize(const ParticleSystem &system, const unsigned int n_threads) override
       {
+        threads              = n_threads;
         const unsigned int n = system.n_particles();
         const unsigned int n_parts =
           std::max(1u, std::min(n_threads, std::max(1u, n / 64)));
@@ -104,40 +116,12 @@ namespace lacerta::physics
           first_particle[p] =
             std::lower_bound(ends.begin(), ends.end(), ends[n] * p / n_parts)
             - ends.begin();
-        std::vector<unsigned int> part_of(n);
-        for (unsigned int p = 0; p < n_parts; ++p)
-          for (unsigned int i = first_particle[p]; i < first_particle[p + 1]; ++i)
-            part_of[i] = p;
 
-        std::vector<SpringSet> inner(n_parts), crossing(n_parts);
-        const SpringSet       &all = system.springs;
-        for (std::size_t s = 0; s < all.size(); ++s)
-        {
-          const unsigned int pa = part_of[all.a[s]], pb = part_of[all.b[s]];
-          if (pa == pb)
-            inner[pa].push_back(all.a[s], all.b[s], all.stiffness[s], all.rest_length[s]);
-          else
-          {
-            crossing[pa].push_back(all.a[s],
-                                   all.b[s],
-                                   all.stiffness[s],
-                                   all.rest_length[s]);
-            crossing[pb].push_back(all.b[s],
-                                   all.a[s],
-                                   all.stiffness[s],
-                                   all.rest_length[s]);
-          }
-        }
-        springs.clear();
-        offsets.assign(n_parts, {});
-        for (unsigned int p = 0; p < n_parts; ++p)
-        {
-          offsets[p][0] = springs.size();
-          append(springs, inner[p]);
-          offsets[p][1] = springs.size();
-          append(springs, crossing[p]);
-          offsets[p][2] = springs.size();
-        }
+        segments.assign(2 * n_parts, Segment());
+        holders.assign(system.springs.size(), no_holders());
+        for (unsigned int s = 0; s < system.springs.size(); ++s)
+          place(system, s);
+        known_springs = system.springs.size();
 
         inverse_mass.resize(n);
         for (unsigned int i = 0; i < n; ++i)
@@ -146,11 +130,55 @@ namespace lacerta::physics
       }
 
       void
+      springs_changed(const ParticleSystem            &system,
+                      const std::vector<unsigned int> &changed) override
+      {
+        const std::size_t  n_springs = system.springs.size();
+        const unsigned int n         = system.n_particles();
+        // New particles join the last range.
+        first_particle.back()           = n;
+        const std::size_t old_particles = inverse_mass.size();
+        inverse_mass.resize(n);
+        for (std::size_t i = old_particles; i < n; ++i)
+          update_inverse_mass(system, i);
+
+        // The listed springs once each, removed ones first and from the end (their
+        // copies are the last of their segments), then the others in order (appended
+        // ones go to the ends of their segments). A listed spring may have been
+        // appended and removed again since (beyond both counts): it has no copies.
+        std::vector<unsigned int> listed;
+        listed.reserve(changed.size() + known_springs
+                       - std::min(known_springs, n_springs));
+        for (const unsigned int s : changed)
+          if (s < std::max(known_springs, n_springs))
+            listed.push_back(s);
+        for (std::size_t s = n_springs; s < known_springs; ++s)
+          listed.push_back(static_cast<unsigned int>(s));
+        std::sort(listed.begin(), listed.end());
+        listed.erase(std::unique(listed.begin(), listed.end()), listed.end());
+        holders.resize(std::max(known_springs, n_springs), no_holders());
+        for (auto s = listed.rbegin(); s != listed.rend() && *s >= n_springs; ++s)
+          unplace(*s);
+        for (const unsigned int s : listed)
+          if (s < n_springs)
+          {
+            place(system, s);
+            update_inverse_mass(system, system.springs.a[s]);
+            update_inverse_mass(system, system.springs.b[s]);
+          }
+        holders.resize(n_springs);
+        known_springs = n_springs;
+
+        if (unbalanced())
+          initialize(system, threads);
+      }
+
+      void
       masses_changed(const ParticleSystem            &system,
                      const std::vector<unsigned int> &particles) override
       {
         for (const unsigned int i : particles)
-          inverse_mass[i] = system.mass[i] > 0 ? 1.0 / system.mass[i] : 0.0;
+          update_inverse_mass(system, i);
       }
 
       void
@@ -205,17 +233,135 @@ namespace lacerta::physics
       }
 
     private:
-      static void
-      append(SpringSet &to, const SpringSet &from)
+      /// The springs of one range: inner (both ends in it) or crossing (end a in it).
+      struct Segment
       {
-        to.a.insert(to.a.end(), from.a.begin(), from.a.end());
-        to.b.insert(to.b.end(), from.b.begin(), from.b.end());
-        to.stiffness.insert(to.stiffness.end(),
-                            from.stiffness.begin(),
-                            from.stiffness.end());
-        to.rest_length.insert(to.rest_length.end(),
-                              from.rest_length.begin(),
-                              from.rest_length.end());
+        SpringSet set;
+        /// The system spring of each entry.
+        std::vector<unsigned int> origin;
+      };
+
+      /// The segments that hold a system spring's copies (up to two).
+      using Holders = std::array<unsigned int, 2>;
+
+      static constexpr unsigned int none = static_cast<unsigned int>(-1);
+
+      static Holders
+      no_holders()
+      {
+        return {none, none};
+      }
+
+      /// The range of particle @p i.
+      unsigned int
+      part_of(const unsigned int i) const
+      {
+        return static_cast<unsigned int>(
+          std::upper_bound(first_particle.begin() + 1, first_particle.end() - 1, i)
+          - first_particle.begin() - 1);
+      }
+
+      void
+      update_inverse_mass(const ParticleSystem &system, const std::size_t i)
+      {
+        inverse_mass[i] = system.mass[i] > 0 ? 1.0 / system.mass[i] : 0.0;
+      }
+
+      /// Where spring @p s is, or goes, in segment @p g (kept in the springs' order).
+      std::size_t
+      slot(const unsigned int g, const unsigned int s) const
+      {
+        const std::vector<unsigned int> &origin = segments[g].origin;
+        return std::lower_bound(origin.begin(), origin.end(), s) - origin.begin();
+      }
+
+      /// Removes spring @p s's copy from segment @p g.
+      void
+      erase(const unsigned int g, const unsigned int s)
+      {
+        Segment          &segment = segments[g];
+        const std::size_t k       = slot(g, s);
+        segment.set.a.erase(segment.set.a.begin() + k);
+        segment.set.b.erase(segment.set.b.begin() + k);
+        segment.set.stiffness.erase(segment.set.stiffness.begin() + k);
+        segment.set.rest_length.erase(segment.set.rest_length.begin() + k);
+        segment.origin.erase(segment.origin.begin() + k);
+      }
+
+      /// Removes every copy of spring @p s.
+      void
+      unplace(const unsigned int s)
+      {
+        for (const unsigned int g : holders[s])
+          if (g != none)
+            erase(g, s);
+        holders[s] = no_holders();
+      }
+
+      /**
+       * Puts system spring @p s (as it is now) into the segments of its ranges: in
+       * place where it already has a copy in that segment, in order otherwise; copies
+       * in segments it left are removed.
+       */
+      void
+      place(const ParticleSystem &system, const unsigned int s)
+      {
+        const SpringSet   &all = system.springs;
+        const unsigned int a = all.a[s], b = all.b[s];
+        const unsigned int pa = part_of(a), pb = part_of(b);
+        // (segment, first end, second end) of each copy.
+        std::array<std::array<unsigned int, 3>, 2> wanted = {
+          {{2 * pa, a, b}, {none, 0, 0}}};
+        if (pa != pb)
+          wanted = {{{2 * pa + 1, a, b}, {2 * pb + 1, b, a}}};
+        for (const unsigned int g : holders[s])
+          if (g != none && g != wanted[0][0] && g != wanted[1][0])
+            erase(g, s);
+        const Holders old = holders[s];
+        holders[s]        = no_holders();
+        for (unsigned int c = 0; c < 2; ++c)
+        {
+          const auto [g, from, to] = wanted[c];
+          if (g == none)
+            continue;
+          holders[s][c]             = g;
+          Segment          &segment = segments[g];
+          const std::size_t k       = slot(g, s);
+          if (g == old[0] || g == old[1])
+          {
+            segment.set.a[k]           = from;
+            segment.set.b[k]           = to;
+            segment.set.stiffness[k]   = all.stiffness[s];
+            segment.set.rest_length[k] = all.rest_length[s];
+            continue;
+          }
+          segment.set.a.insert(segment.set.a.begin() + k, from);
+          segment.set.b.insert(segment.set.b.begin() + k, to);
+          segment.set.stiffness.insert(segment.set.stiffness.begin() + k,
+                                       all.stiffness[s]);
+          segment.set.rest_length.insert(segment.set.rest_length.begin() + k,
+                                         all.rest_length[s]);
+          segment.origin.insert(segment.origin.begin() + k, s);
+        }
+      }
+
+      /// Whether a range evaluates more than 1.25 times the mean number of spring
+      /// copies (plus a little, so that small systems are not re-partitioned).
+      bool
+      unbalanced() const
+      {
+        const std::size_t n_parts = first_particle.size() - 1;
+        if (n_parts == 1)
+          return false;
+        std::size_t total = 0, largest = 0;
+        for (std::size_t p = 0; p < n_parts; ++p)
+        {
+          const std::size_t load =
+            segments[2 * p].origin.size() + segments[2 * p + 1].origin.size();
+          total += load;
+          largest = std::max(largest, load);
+        }
+        return largest > 1.25 * total / n_parts + 256;
       }
 
       /// Zeroes the forces of part @p p's particles and adds its springs' forces.
@@ -229,20 +375,18 @@ namespace lacerta::physics
         std::memset(f + 3 * first_particle[p],
                     0,
                     3 * sizeof(double) * (first_particle[p + 1] - first_particle[p]));
-        const double beta = system.spring_damping;
+        const double     beta     = system.spring_damping;
+        const SpringSet &inner    = segments[2 * p].set;
+        const SpringSet &crossing = segments[2 * p + 1].set;
         if (beta > 0)
         {
-          add_spring_forces<true, true>(
-            springs, offsets[p][0], offsets[p][1], x, v, beta, f);
-          add_spring_forces<true, false>(
-            springs, offsets[p][1], offsets[p][2], x, v, beta, f);
+          add_spring_forces<true, true>(inner, 0, inner.size(), x, v, beta, f);
+          add_spring_forces<true, false>(crossing, 0, crossing.size(), x, v, beta, f);
         }
         else
         {
-          add_spring_forces<false, true>(
-            springs, offsets[p][0], offsets[p][1], x, v, beta, f);
-          add_spring_forces<false, false>(
-            springs, offsets[p][1], offsets[p][2], x, v, beta, f);
+          add_spring_forces<false, true>(inner, 0, inner.size(), x, v, beta, f);
+          add_spring_forces<false, false>(crossing, 0, crossing.size(), x, v, beta, f);
         }
       }
 
@@ -251,7 +395,7 @@ namespace lacerta::physics
       void
       for_each_part(const Work &work) const
       {
-        const unsigned int n_parts = offsets.size();
+        const unsigned int n_parts = first_particle.size() - 1;
         if (n_parts == 1)
         {
           work(0);
@@ -271,11 +415,16 @@ namespace lacerta::physics
           });
       }
 
-      SpringSet                               springs;
-      std::vector<std::array<std::size_t, 3>> offsets;
-      std::vector<unsigned int>               first_particle;
-      std::vector<double>                     inverse_mass;
-      std::unique_ptr<tbb::task_arena>        arena;
+      /// Inner and crossing springs of range p: segments 2p and 2p + 1.
+      std::vector<Segment> segments;
+      /// The segments that hold each system spring's copies.
+      std::vector<Holders>             holders;
+      std::vector<unsigned int>        first_particle;
+      std::vector<double>              inverse_mass;
+      std::unique_ptr<tbb::task_arena> arena;
+      /// The springs and threads the model was last told of.
+      std::size_t  known_springs = 0;
+      unsigned int threads       = 1;
     };
   } // namespace
 

@@ -73,6 +73,13 @@ namespace lacerta::physics
 
 
   void
+  ParticleSystem::springs_changed(const std::vector<unsigned int> &changed)
+  {
+    forces->springs_changed(*this, changed);
+  }
+
+
+  void
   ParticleSystem::masses_changed(const std::vector<unsigned int> &particles)
   {
     forces->masses_changed(*this, particles);

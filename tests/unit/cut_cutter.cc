@@ -724,3 +724,43 @@ TEST(CutCutter, ACutNearAVertexLayerKeepsTheCriticalStepWithMassRedistribution)
   for (unsigned int p = 0; p < 2; ++p)
     EXPECT_NEAR(mass[p], 1000.0 * volume[p], 1e-9 * 1000.0) << "piece " << p;
 }
+
+
+TEST(CutCutter, TheForceModelFollowsTheCutLocally)
+{
+  // Three ranges of particles, so that the cut's springs cross between them; after
+  // every blade motion the force model, updated only for the springs the motion
+  // changed, gives the accelerations of a model made afresh.
+  std::mt19937 rng(11);
+  CutFixture   f(8, rng, vertical(-0.2, 0.43), 1.1);
+  f.system->update_force_model(3);
+  std::vector<double> x(f.system->position), v(x.size(), 0.0);
+  unsigned int        motions = 0;
+  f.after_step                = [&](const cut::CutStepStatistics &s)
+  {
+    if (!s.changed)
+      return;
+    ++motions;
+    auto fresh = physics::ForceModelRegistry::create("linear springs");
+    fresh->initialize(*f.system, 3);
+    std::vector<double> mine(f.system->position.size()), theirs(mine.size());
+    f.system->force_model().compute_acceleration(*f.system,
+                                                 f.system->position.data(),
+                                                 f.system->velocity.data(),
+                                                 mine.data());
+    fresh->compute_acceleration(*f.system,
+                                f.system->position.data(),
+                                f.system->velocity.data(),
+                                theirs.data());
+    double largest = 0, difference = 0;
+    for (std::size_t i = 0; i < mine.size(); ++i)
+    {
+      largest    = std::max(largest, std::abs(theirs[i]));
+      difference = std::max(difference, std::abs(mine[i] - theirs[i]));
+    }
+    EXPECT_LE(difference, 1e-12 * largest) << "blade motion " << motions;
+  };
+  f.stroke({vertical(-0.2, 0.43), vertical(1.2, 0.57)}, 12);
+  EXPECT_GT(motions, 3u);
+  EXPECT_EQ(f.component_volumes().size(), 2u);
+}

@@ -49,7 +49,8 @@ namespace lacerta::cut
     /// Sub-steps of the swept surface, and those whose cut was postponed.
     unsigned int sweeps = 0, postponed = 0;
     /// Wall time of the local mesh and physics update, and of the force model's
-    /// re-initialisation (global: it repartitions the springs), in seconds.
+    /// update for the springs the motion changed (ForceModel::springs_changed()), in
+    /// seconds.
     double update_seconds = 0, reinit_seconds = 0;
     /**
      * Where the time went, in seconds. `search_seconds` (not part of update_seconds):
@@ -394,6 +395,9 @@ namespace lacerta::cut
     mesh::TetMesh::EdgeUpdate                edge_update;
     /// The end of the last lap().
     std::chrono::steady_clock::time_point lap_start;
+    /// The springs the sweeps of the current blade motion added, moved or restiffened,
+    /// passed to ParticleSystem::springs_changed() at its end.
+    std::vector<unsigned int> changed_springs;
     /// Where sweeps are recorded (set_recorder()), or nullptr.
     std::vector<CutRecord> *recorder = nullptr;
     /// Per child of the sweep being applied, when recording: (split, child of the split).

@@ -36,11 +36,26 @@ namespace lacerta::physics
     parse_parameters(dealii::ParameterHandler &prm);
 
     /**
-     * Prepares the evaluation for the system's current springs on @p n_threads threads.
-     * Must be called again when the springs change (cuts).
+     * Prepares the evaluation for the system's current springs on @p n_threads threads
+     * (a new system or level of detail). A local change of the springs (a cut, a tear)
+     * is passed to springs_changed() instead.
      */
     virtual void
     initialize(const ParticleSystem &system, unsigned int n_threads) = 0;
+
+    /**
+     * The springs of @p system changed locally since the model last saw them: the
+     * springs listed in @p changed (indices into `system.springs`, appended ones
+     * included; an index may be listed more than once) were added, moved into a
+     * retired slot or given another stiffness; the slots from `system.springs.size()`
+     * up to the count the model last saw were removed; particles may have been
+     * appended. The masses that changed are those of new particles and of the ends of
+     * the changed springs. Costs O(changed.size()) amortised, whatever the system's
+     * size: nothing global per cut.
+     */
+    virtual void
+    springs_changed(const ParticleSystem            &system,
+                    const std::vector<unsigned int> &changed) = 0;
 
     /**
      * The masses of @p particles changed (nothing else did): whatever the model keeps

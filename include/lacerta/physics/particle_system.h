@@ -96,11 +96,19 @@ namespace lacerta::physics
     update_force_model(unsigned int n_threads);
 
     /**
-     * Re-initialises the force model after the springs changed (a cut), on the thread
-     * count it was set with.
+     * Re-initialises the force model for all springs, on the thread count it was set
+     * with.
      */
     void
     refresh_force_model();
+
+    /**
+     * Tells the force model that the springs listed in @p changed (and the slots
+     * removed from the end of `springs`, and new particles) changed locally: a cut or
+     * a tear (ForceModel::springs_changed()).
+     */
+    void
+    springs_changed(const std::vector<unsigned int> &changed);
 
     /**
      * Tells the force model that the masses of @p particles changed (and nothing else).

@@ -49,6 +49,21 @@ namespace lacerta::physics
       rest_length.reserve(n);
     }
 
+    /// Removes spring @p to by moving the last spring into its slot (as the mesh
+    /// retires an edge); removes the last spring if @p to is the last.
+    void
+    retire(const std::size_t to)
+    {
+      a[to]           = a.back();
+      b[to]           = b.back();
+      stiffness[to]   = stiffness.back();
+      rest_length[to] = rest_length.back();
+      a.pop_back();
+      b.pop_back();
+      stiffness.pop_back();
+      rest_length.pop_back();
+    }
+
     /// Removes all springs.
     void
     clear()

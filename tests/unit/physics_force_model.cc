@@ -1,0 +1,157 @@
+// The force model's local update (ForceModel::springs_changed()): after springs are
+// removed, moved, added and restiffened and particles appended, the model gives the
+// forces and accelerations of a model made afresh for the same system.
+#include <lacerta/physics/force_model.h>
+#include <lacerta/physics/particle_system.h>
+
+#include <gtest/gtest.h>
+
+#include "physics_test_support.h"
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+using namespace lacerta;
+
+namespace
+{
+  /// The largest difference between the forces (spring forces, then accelerations)
+  /// of @p system's model and a model made afresh, relative to the largest force.
+  std::array<double, 2>
+  difference_to_a_fresh_model(const physics::ParticleSystem &system,
+                              const unsigned int             n_threads,
+                              std::mt19937                  &rng)
+  {
+    auto fresh = physics::ForceModelRegistry::create("linear springs");
+    fresh->initialize(system, n_threads);
+    std::uniform_real_distribution<double> jitter(-0.02, 0.02);
+    std::vector<double>                    x(system.position), v(x.size());
+    for (std::size_t i = 0; i < x.size(); ++i)
+    {
+      x[i] += jitter(rng);
+      v[i] = 10 * jitter(rng);
+    }
+    std::array<double, 2> difference = {0, 0};
+    for (unsigned int kind = 0; kind < 2; ++kind)
+    {
+      std::vector<double> mine(x.size()), theirs(x.size());
+      if (kind == 0)
+      {
+        system.force_model().compute_spring_forces(system,
+                                                   x.data(),
+                                                   v.data(),
+                                                   mine.data());
+        fresh->compute_spring_forces(system, x.data(), v.data(), theirs.data());
+      }
+      else
+      {
+        system.force_model().compute_acceleration(system,
+                                                  x.data(),
+                                                  v.data(),
+                                                  mine.data());
+        fresh->compute_acceleration(system, x.data(), v.data(), theirs.data());
+      }
+      double largest = 0;
+      for (std::size_t i = 0; i < x.size(); ++i)
+      {
+        largest          = std::max(largest, std::abs(theirs[i]));
+        difference[kind] = std::max(difference[kind], std::abs(mine[i] - theirs[i]));
+      }
+      difference[kind] /= largest;
+    }
+    return difference;
+  }
+} // namespace
+
+
+namespace
+{
+  /// Random local changes of the springs of a box's system on @p n_threads threads,
+  /// 30 rounds; after each the model must be within @p tolerance of a fresh one.
+  void
+  expect_local_changes_match_a_fresh_model(const unsigned int n_threads,
+                                           const double       tolerance)
+  {
+    const mesh::TetMesh mesh   = test_support::distorted_box(8, 0.2, {1, 1, 1});
+    auto                system = test_support::make_system(mesh, 1000, 1e4, n_threads);
+    system->spring_damping     = 1e-3;
+    std::mt19937 rng(5);
+    for (unsigned int round = 0; round < 30; ++round)
+    {
+      physics::SpringSet                    &springs = system->springs;
+      std::vector<unsigned int>              changed;
+      std::uniform_real_distribution<double> unit(0, 1);
+      const auto                             any_spring = [&]
+      { return static_cast<unsigned int>(unit(rng) * (springs.size() - 1)); };
+      // New particles (as a cut's copies), joined to old ones far apart in the
+      // numbering, so that their springs cross between ranges.
+      for (unsigned int k = 0; k < 5; ++k)
+      {
+        const unsigned int old = static_cast<unsigned int>(unit(rng) * mesh.n_vertices());
+        const unsigned int p =
+          system->add_particle({{0, 0, 0}}, {{0, 0, 0}}, {{0, 0, 0}});
+        for (unsigned int d = 0; d < 3; ++d)
+          system->position[3 * p + d] = system->position[3 * old + d] + 0.01 * (d + 1);
+        system->mass[p] = 0.5;
+        for (const unsigned int other : {old, 0u, system->n_particles() / 2})
+        {
+          changed.push_back(springs.size());
+          springs.push_back(p, other, 100 * (1 + unit(rng)), 0.02);
+        }
+      }
+      // Retire springs as the mesh retires edges: the last one moves into the slot (new
+      // springs too: listed, then gone, beyond the count the model knew).
+      for (unsigned int k = 0; k < 20; ++k)
+      {
+        const unsigned int from = springs.size() - 1, to = k == 0 ? from : any_spring();
+        springs.retire(to);
+        changed.push_back(to);
+      }
+      // Restiffen some, and change some masses at their ends.
+      for (unsigned int k = 0; k < 30; ++k)
+      {
+        const unsigned int s = any_spring();
+        springs.stiffness[s] *= 0.5 + unit(rng);
+        system->mass[springs.a[s]] *= 0.9 + 0.2 * unit(rng);
+        changed.push_back(s);
+      }
+      system->springs_changed(changed);
+      const auto difference = difference_to_a_fresh_model(*system, n_threads, rng);
+      EXPECT_LE(difference[0], tolerance) << "spring forces, round " << round;
+      EXPECT_LE(difference[1], tolerance) << "accelerations, round " << round;
+    }
+  }
+} // namespace
+
+
+TEST(ForceModelLocalUpdate, RandomLocalChangesGiveTheForcesOfAFreshModel)
+{
+  // On several ranges the springs' copies may sit in other ranges than a fresh
+  // partition would put them: the same forces up to rounding.
+  expect_local_changes_match_a_fresh_model(3, 1e-12);
+}
+
+
+TEST(ForceModelLocalUpdate, OnOneRangeTheForcesAreAFreshModelsToTheLastBit)
+{
+  // The springs are summed in the system's order, as initialize() sums them: a cut
+  // leaves no trace of the update in the results.
+  expect_local_changes_match_a_fresh_model(1, 0.0);
+}
+
+
+TEST(ForceModelLocalUpdate, RemovingEverySpringLeavesNoForce)
+{
+  const mesh::TetMesh mesh   = test_support::distorted_box(4, 0.2, {1, 1, 1});
+  auto                system = test_support::make_system(mesh, 1000, 1e4, 2);
+  const std::size_t   n      = system->springs.size();
+  system->springs.clear();
+  system->springs_changed({});
+  std::vector<double> f(system->position.size(), 1.0);
+  system->force_model().compute_spring_forces(*system,
+                                              system->position.data(),
+                                              system->velocity.data(),
+                                              f.data());
+  EXPECT_EQ(*std::max_element(f.begin(), f.end()), 0.0) << n << " springs removed";
+  EXPECT_EQ(*std::min_element(f.begin(), f.end()), 0.0) << n << " springs removed";
+}
