@@ -41,7 +41,7 @@ namespace lacerta::postprocess
           << "step,time,time_step,substeps,kinetic_energy,elastic_energy,"
              "body_force_energy,input_work,force_wall_s,step_wall_s,mesh_size,cut_tets,"
              "created_tets,update_wall_ms,over_limit,tears,torn_tets,tear_created_tets,"
-             "tear_wall_ms,split_fragments,mt_update_wall_ms\n";
+             "tear_wall_ms,split_fragments,mt_update_wall_ms,cut_step_wall_ms\n";
       }
 
       bool
@@ -57,7 +57,7 @@ namespace lacerta::postprocess
         std::snprintf(line,
                       sizeof(line),
                       "%u,%.9g,%.6g,%u,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%u,%u,%u,%.6g,%u,%u,"
-                      "%u,%u,%.6g,%u,%.6g\n",
+                      "%u,%u,%.6g,%u,%.6g,%.6g\n",
                       s.step,
                       s.time,
                       s.time_step,
@@ -78,7 +78,8 @@ namespace lacerta::postprocess
                       s.tear_created_tets,
                       test_mode ? 0.0 : 1e3 * s.tear_seconds,
                       s.split_fragments,
-                      test_mode ? 0.0 : 1e3 * s.mt_update_seconds);
+                      test_mode ? 0.0 : 1e3 * s.mt_update_seconds,
+                      test_mode ? 0.0 : 1e3 * s.cut_step_seconds);
         file << line;
       }
 

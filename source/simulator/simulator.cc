@@ -494,7 +494,7 @@ namespace lacerta
       const double dt         = std::min(time_step, end_time - time);
       const auto   step_start = Clock::now();
       state.cut_tets = state.created_tets = 0;
-      state.update_seconds                = 0;
+      state.update_seconds = state.cut_step_seconds = 0;
       state.over_limit = state.tears = state.torn_tets = state.tear_created_tets = 0;
       state.tear_seconds                                                         = 0;
       state.split_fragments                                                      = 0;
@@ -508,6 +508,8 @@ namespace lacerta
         state.cut_tets       = cut.cut_tets;
         state.created_tets   = cut.created_tets;
         state.update_seconds = cut.update_seconds;
+        state.cut_step_seconds =
+          cut.search_seconds + cut.update_seconds + cut.reinit_seconds;
         cut_changed          = cut.changed;
         stroke_cut += cut.cut_tets;
         stroke_created += cut.created_tets;

@@ -48,6 +48,9 @@ namespace lacerta::postprocess
     /// wall time of the mesh update (s); all zero in a scene without a tool.
     unsigned int cut_tets = 0, created_tets = 0;
     double       update_seconds = 0;
+    /// Wall time of the whole blade motion: first contact and propagation, the mesh
+    /// and physics update and the force model's update (s).
+    double cut_step_seconds = 0;
     /// Lacerations of this step (Section 7): surface springs past their limit, tears,
     /// tetrahedra the tear split and created, and its wall time (s); all zero in a
     /// scene without lacerations.
