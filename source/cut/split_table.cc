@@ -1,3 +1,4 @@
+#include <lacerta/cut/geometry.h>
 #include <lacerta/cut/split_table.h>
 
 #include <algorithm>
@@ -50,38 +51,6 @@ namespace lacerta::cut
       for (; m; m &= m - 1)
         ++c;
       return c;
-    }
-
-    Point
-    operator-(const Point &a, const Point &b)
-    {
-      return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-    }
-
-    Point
-    operator+(const Point &a, const Point &b)
-    {
-      return {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
-    }
-
-    Point
-    operator*(const double s, const Point &a)
-    {
-      return {s * a[0], s * a[1], s * a[2]};
-    }
-
-    double
-    dot(const Point &a, const Point &b)
-    {
-      return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    }
-
-    Point
-    cross(const Point &a, const Point &b)
-    {
-      return {a[1] * b[2] - a[2] * b[1],
-              a[2] * b[0] - a[0] * b[2],
-              a[0] * b[1] - a[1] * b[0]};
     }
 
     // Faces (bit f) that contain a vertex or an edge.
@@ -154,13 +123,13 @@ namespace lacerta::cut
     {
       Point c{0, 0, 0};
       for (const auto &p : positions)
-        c = c + (1.0 / positions.size()) * p;
-      const Point                                 u = positions[0] - c;
+        c = add(c, scale(1.0 / positions.size(), p));
+      const Point                                 u = sub(positions[0], c);
       const Point                                 w = cross(normal, u);
       std::vector<std::pair<double, std::size_t>> angle;
       for (std::size_t i = 0; i < positions.size(); ++i)
       {
-        const Point r = positions[i] - c;
+        const Point r = sub(positions[i], c);
         angle.emplace_back(std::atan2(dot(w, r), dot(u, r)), i);
       }
       std::sort(angle.begin(), angle.end());
@@ -249,20 +218,20 @@ namespace lacerta::cut
             {
               const unsigned i = tet_edge_vertices[c.index][0],
                              j = tet_edge_vertices[c.index][1];
-              through[k]       = X[i] + param(rng) * (X[j] - X[i]);
+              through[k]       = lerp(X[i], X[j], param(rng));
             }
           }
-          Point        normal = cross(through[1] - through[0], through[2] - through[0]);
-          const double length = std::sqrt(dot(normal, normal));
+          Point normal = cross(sub(through[1], through[0]), sub(through[2], through[0]));
+          const double length = norm(normal);
           if (length < 1e-6)
             continue;
-          normal      = (1.0 / length) * normal;
+          normal      = scale(1.0 / length, normal);
           s.origin    = through[0];
           bool   ok   = true;
           double flip = 0;
           for (unsigned v = 0; v < 4; ++v)
           {
-            s.d[v] = dot(normal, X[v] - s.origin);
+            s.d[v] = dot(normal, sub(X[v], s.origin));
             if (side[v] == 0)
             {
               s.d[v] = 0;
@@ -279,7 +248,7 @@ namespace lacerta::cut
           if (!ok)
             continue;
           // Orient the normal towards the pattern's + side.
-          s.normal = flip * normal;
+          s.normal = scale(flip, normal);
           for (unsigned v = 0; v < 4; ++v)
             s.d[v] *= flip;
           for (unsigned e = 0; e < 6; ++e)
@@ -289,7 +258,7 @@ namespace lacerta::cut
               const double   t = s.d[i] / (s.d[i] - s.d[j]);
               if (t < 0.02 || t > 0.98)
                 ok = false;
-              s.x[first_copy(e)] = s.x[second_copy(e)] = X[i] + t * (X[j] - X[i]);
+              s.x[first_copy(e)] = s.x[second_copy(e)] = lerp(X[i], X[j], t);
             }
           if (!ok)
             continue;
@@ -350,8 +319,8 @@ namespace lacerta::cut
                 ++fa;
               while (!(f_before & (1u << fb)))
                 ++fb;
-              p.x[face_node(fa)] = a_last + param(rng) * (a_next - a_last);
-              p.x[face_node(fb)] = a_first + param(rng) * (a_before - a_first);
+              p.x[face_node(fa)] = lerp(a_last, a_next, param(rng));
+              p.x[face_node(fb)] = lerp(a_first, a_before, param(rng));
               // Crack polygon: the run, then the two front points.
               p.corners     = run;
               const Key key = make_key(run_edges, run_vertices, f_after | f_before);
@@ -391,7 +360,7 @@ namespace lacerta::cut
           if (edges & (1u << e))
           {
             const unsigned i = tet_edge_vertices[e][0], j = tet_edge_vertices[e][1];
-            s.x[first_copy(e)] = X[i] + param(rng) * (X[j] - X[i]);
+            s.x[first_copy(e)] = lerp(X[i], X[j], param(rng));
           }
         cfg.samples.push_back(s);
       }
@@ -488,12 +457,12 @@ namespace lacerta::cut
           for (unsigned k = 0; k < 3; ++k)
           {
             out[k]   = t[k] == n ? face_node(f) : poly[t[k]];
-            centroid = centroid + (1.0 / 3.0) * s.x[out[k]];
+            centroid = add(centroid, scale(1.0 / 3.0, s.x[out[k]]));
           }
           if (copies)
           {
             // An edge point takes the copy of the side the triangle lies on.
-            const double dc = dot(s.normal, centroid - s.origin);
+            const double dc = dot(s.normal, sub(centroid, s.origin));
             if (std::abs(dc) < 1e-9)
               throw std::logic_error("split table: face triangle on the cut plane");
             for (unsigned k = 0; k < 3; ++k)
@@ -836,7 +805,7 @@ namespace lacerta::cut
       {
         // One corner: orient by geometry.
         const Point a = corner_position(last, s0);
-        if (dot(s0.normal, cross(s0.x[front[0]] - a, s0.x[front[1]] - a)) < 0)
+        if (dot(s0.normal, cross(sub(s0.x[front[0]], a), sub(s0.x[front[1]], a))) < 0)
           std::swap(after, before);
       }
       else if (!(last_faces & (1u << (after - 16))))
@@ -868,7 +837,7 @@ namespace lacerta::cut
       {
         Point area{0, 0, 0};
         for (std::size_t k = 0; k < plus.size(); ++k)
-          area = area + cross(s0.x[plus[k]], s0.x[plus[(k + 1) % plus.size()]]);
+          area = add(area, cross(s0.x[plus[k]], s0.x[plus[(k + 1) % plus.size()]]));
         if (dot(area, s0.normal) <= 0)
           throw std::logic_error("split table: crack polygon orientation in " + cfg.name);
       }
@@ -1024,7 +993,7 @@ namespace lacerta::cut
     double
     squared_distance(const Point &a, const Point &b)
     {
-      return dot(a - b, a - b);
+      return dot(sub(a, b), sub(a, b));
     }
   } // namespace
 
@@ -1307,10 +1276,10 @@ namespace lacerta::cut
           const Point       &p     = local < 4    ? cut.points[local]
                                      : local < 16 ? result.edge_points[(local - 4) % 6]
                                                   : result.face_points[local - 16];
-          c                        = c + p;
+          c                        = add(c, p);
           ++n;
         }
-      result.interior_point = (1.0 / n) * c;
+      result.interior_point = scale(1.0 / n, c);
     }
     return result.kind;
   }

@@ -1,4 +1,5 @@
 #include <lacerta/base/exceptions.h>
+#include <lacerta/mesh/point.h>
 #include <lacerta/mt/builder.h>
 
 #include <algorithm>
@@ -12,36 +13,16 @@ namespace lacerta::mt
 {
   namespace
   {
+    using mesh::add;
+    using mesh::cross;
+    using mesh::distance;
+    using mesh::dot;
+    using mesh::norm;
     using mesh::Point3;
+    using mesh::scale;
+    using mesh::sub;
     using mesh::Tet;
     constexpr std::uint32_t none = mesh::invalid_index;
-
-    Point3
-    minus(const Point3 &a, const Point3 &b)
-    {
-      return {{a[0] - b[0], a[1] - b[1], a[2] - b[2]}};
-    }
-
-    double
-    dot(const Point3 &a, const Point3 &b)
-    {
-      return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    }
-
-    Point3
-    cross(const Point3 &a, const Point3 &b)
-    {
-      return {{a[1] * b[2] - a[2] * b[1],
-               a[2] * b[0] - a[0] * b[2],
-               a[0] * b[1] - a[1] * b[0]}};
-    }
-
-    double
-    distance(const Point3 &a, const Point3 &b)
-    {
-      const Point3 d = minus(a, b);
-      return std::sqrt(dot(d, d));
-    }
 
     /// Distance from @p p to the triangle (a, b, c), by its closest point (Ericson).
     double
@@ -50,21 +31,20 @@ namespace lacerta::mt
                             const Point3 &b,
                             const Point3 &c)
     {
-      const Point3 ab = minus(b, a), ac = minus(c, a), ap = minus(p, a);
+      const Point3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
       const double d1 = dot(ab, ap), d2 = dot(ac, ap);
       if (d1 <= 0 && d2 <= 0)
         return distance(p, a);
-      const Point3 bp = minus(p, b);
+      const Point3 bp = sub(p, b);
       const double d3 = dot(ab, bp), d4 = dot(ac, bp);
       if (d3 >= 0 && d4 <= d3)
         return distance(p, b);
       const double vc = d1 * d4 - d3 * d2;
-      const auto   on = [&](const Point3 &o, const Point3 &e, const double s) {
-        return distance(p, {{o[0] + s * e[0], o[1] + s * e[1], o[2] + s * e[2]}});
-      };
+      const auto   on = [&](const Point3 &o, const Point3 &e, const double s)
+      { return distance(p, add(o, scale(s, e))); };
       if (vc <= 0 && d1 >= 0 && d3 <= 0)
         return on(a, ab, d1 / (d1 - d3));
-      const Point3 cp = minus(p, c);
+      const Point3 cp = sub(p, c);
       const double d5 = dot(ab, cp), d6 = dot(ac, cp);
       if (d6 >= 0 && d5 <= d6)
         return distance(p, c);
@@ -73,21 +53,18 @@ namespace lacerta::mt
         return on(a, ac, d2 / (d2 - d6));
       const double va = d3 * d6 - d5 * d4;
       if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-        return on(b, minus(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6)));
+        return on(b, sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6)));
       const double denominator = 1 / (va + vb + vc);
       const double v = vb * denominator, w = vc * denominator;
-      return distance(p,
-                      {{a[0] + ab[0] * v + ac[0] * w,
-                        a[1] + ab[1] * v + ac[1] * w,
-                        a[2] + ab[2] * v + ac[2] * w}});
+      return distance(p, add(add(a, scale(v, ab)), scale(w, ac)));
     }
 
     /// Unit normal of (a, b, c); zero if degenerate.
     Point3
     unit_normal(const Point3 &a, const Point3 &b, const Point3 &c)
     {
-      Point3       n      = cross(minus(b, a), minus(c, a));
-      const double length = std::sqrt(dot(n, n));
+      Point3       n      = cross(sub(b, a), sub(c, a));
+      const double length = norm(n);
       if (length > 0)
         for (double &x : n)
           x /= length;
@@ -1002,7 +979,7 @@ namespace lacerta::mt
                                std::pair(&b, &d),
                                std::pair(&c, &d)})
     {
-      const Point3 e = minus(*p, *q);
+      const Point3 e = sub(*p, *q);
       squares += dot(e, e);
     }
     return 12 * std::cbrt(9 * volume * volume) / squares;

@@ -1,12 +1,14 @@
 /**
  * @file
- * Small vector algebra and intersection predicates on plain points, shared by the
- * cutter, the bounding-volume tree and the tests. Plain C++17, inline: the cutter's
- * inner loops call them per edge.
+ * Intersection predicates, barycentric coordinates and boxes on plain points, shared by
+ * the cutter, the bounding-volume tree and the tests. Plain C++17, inline: the cutter's
+ * inner loops call them per edge. The vector algebra they use is mesh/point.h's,
+ * brought into lacerta::cut below.
  */
 #pragma once
 
 #include <lacerta/cut/tet_decomposition.h>
+#include <lacerta/mesh/point.h>
 
 #include <algorithm>
 #include <array>
@@ -14,63 +16,16 @@
 
 namespace lacerta::cut
 {
-  /// a - b.
-  inline Point
-  sub(const Point &a, const Point &b)
-  {
-    return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-  }
-
-  /// a + b.
-  inline Point
-  add(const Point &a, const Point &b)
-  {
-    return {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
-  }
-
-  /// s a.
-  inline Point
-  scale(const double s, const Point &a)
-  {
-    return {s * a[0], s * a[1], s * a[2]};
-  }
-
-  /// a + t (b - a).
-  inline Point
-  lerp(const Point &a, const Point &b, const double t)
-  {
-    return add(a, scale(t, sub(b, a)));
-  }
-
-  /// Scalar product.
-  inline double
-  dot(const Point &a, const Point &b)
-  {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-  }
-
-  /// Vector product.
-  inline Point
-  cross(const Point &a, const Point &b)
-  {
-    return {a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0]};
-  }
-
-  /// Euclidean length.
-  inline double
-  norm(const Point &a)
-  {
-    return std::sqrt(dot(a, a));
-  }
-
-  /// a / |a|.
-  inline Point
-  normalized(const Point &a)
-  {
-    return scale(1.0 / norm(a), a);
-  }
+  // The vector algebra of cut::Point (= mesh::Point3), for unqualified and cut::
+  // qualified calls.
+  using mesh::add;
+  using mesh::cross;
+  using mesh::dot;
+  using mesh::lerp;
+  using mesh::norm;
+  using mesh::normalized;
+  using mesh::scale;
+  using mesh::sub;
 
   /// Signed volume of the tetrahedron (a, b, c, d).
   inline double

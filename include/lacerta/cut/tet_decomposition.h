@@ -9,6 +9,8 @@
  */
 #pragma once
 
+#include <lacerta/mesh/point.h>
+
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -17,9 +19,10 @@
 namespace lacerta::cut
 {
   /**
-   * A point or vector in three dimensions.
+   * A point or vector in three dimensions: the same type as mesh::Point3, whose
+   * algebra (mesh/point.h) geometry.h brings into this namespace.
    */
-  using Point = std::array<double, 3>;
+  using Point = mesh::Point3;
 
   /**
    * A node of a small polyhedron, by an identifier below 32.

@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include <lacerta/mesh/point.h>
 #include <lacerta/mesh/vertex_stars.h>
 
 #include <array>
@@ -14,9 +15,6 @@
 
 namespace lacerta::mesh
 {
-  /// A point or vector in 3D, as plain data (the hot loops do not use deal.II types).
-  using Point3 = std::array<double, 3>;
-
   /// The four vertex ids of a tetrahedron, positively oriented.
   using Tet = std::array<unsigned int, 4>;
 
