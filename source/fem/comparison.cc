@@ -2,6 +2,7 @@
 // integrated alongside it with Newmark, on the same mesh, constraints and loads.
 
 #include <lacerta/base/exceptions.h>
+#include <lacerta/base/output_file.h>
 #include <lacerta/base/parameter_utilities.h>
 #include <lacerta/fem/elasticity.h>
 #include <lacerta/fem/scene_problem.h>
@@ -13,8 +14,8 @@
 #include <deal.II/base/utilities.h>
 
 #include <cmath>
-#include <fstream>
 #include <iostream>
+#include <sstream>
 
 namespace lacerta::fem
 {
@@ -73,11 +74,7 @@ namespace lacerta::fem
       void
       initialize(const std::string &output_directory, bool) override
       {
-        table.open(output_directory + "/comparison.csv");
-        if (!table)
-          throw_error("Fem comparison: cannot write '",
-                      output_directory,
-                      "/comparison.csv'.");
+        table = OutputFile(output_directory + "/comparison.csv");
       }
 
       void
@@ -106,11 +103,13 @@ namespace lacerta::fem
         const NodalError error = nodal_error(springs, expected);
         total.add(error);
 
-        table << state.time << ',' << error.relative_l2() << ',' << error.max_error;
+        std::ostringstream row;
+        row << state.time << ',' << error.relative_l2() << ',' << error.max_error;
         for (const unsigned int v : probe_vertices)
           for (unsigned int d = 0; d < 3; ++d)
-            table << ',' << springs[3 * v + d] << ',' << fem.vertex[3 * v + d];
-        table << '\n';
+            row << ',' << springs[3 * v + d] << ',' << fem.vertex[3 * v + d];
+        row << '\n';
+        table.append(row.str());
         if (state.time >= next_print - 1e-9 * state.time_step)
         {
           next_print += print_interval;
@@ -146,11 +145,14 @@ namespace lacerta::fem
           }
           probe_vertices.push_back(best);
         }
-        table << "time,error_rel_l2,error_max";
+        std::ostringstream header;
+        header << "time,error_rel_l2,error_max";
         for (unsigned int i = 0; i < probe_vertices.size(); ++i)
           for (const char *d : {"x", "y", "z"})
-            table << ",probe" << i << "_springs_u" << d << ",probe" << i << "_fem_u" << d;
-        table << '\n';
+            header << ",probe" << i << "_springs_u" << d << ",probe" << i << "_fem_u"
+                   << d;
+        header << '\n';
+        table.append(header.str());
         next_print = print_interval;
 
         if (n_frequencies > 0)
@@ -174,7 +176,7 @@ namespace lacerta::fem
       Problem                           problem;
       std::unique_ptr<ElasticitySolver> solver;
       NodalError                        total;
-      std::ofstream                     table;
+      OutputFile                        table;
     };
   } // namespace
 

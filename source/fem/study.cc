@@ -1,4 +1,5 @@
 #include <lacerta/base/exceptions.h>
+#include <lacerta/base/output_file.h>
 #include <lacerta/fem/elasticity.h>
 #include <lacerta/fem/scene_problem.h>
 #include <lacerta/fem/spring_statics.h>
@@ -14,8 +15,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -452,11 +451,9 @@ namespace lacerta::fem
 
     if (root)
     {
-      std::filesystem::create_directories(output_directory);
-      const std::string csv = output_directory + "/study.csv";
-      std::ofstream     file(csv);
-      if (!file)
-        throw_error("Study: cannot write '", csv, "'.");
+      create_output_directory(output_directory);
+      const std::string  csv = output_directory + "/study.csv";
+      std::ostringstream file;
       file
         << "variant,model,tets,integrator,time_step,wall_time_s,error_rel_l2,error_max\n";
       file << std::setprecision(8);
@@ -465,7 +462,7 @@ namespace lacerta::fem
              << row.integrator << ',' << row.time_step << ','
              << (test_mode ? 0.0 : row.wall_time) << ',' << row.error_l2 << ','
              << row.error_max << '\n';
-      file.close();
+      write_file_atomically(csv, file.str());
       out << "Wrote " << (test_mode ? std::string("study.csv") : csv) << "\n";
       if (plot)
       {

@@ -1,4 +1,5 @@
 #include <lacerta/base/exceptions.h>
+#include <lacerta/base/output_file.h>
 #include <lacerta/mt/storage.h>
 
 #include <chrono>
@@ -95,18 +96,8 @@ namespace lacerta::mt
     hash.add(buffer.data(), buffer.size());
     put(&hash.value, sizeof(hash.value));
 
-    // A temporary file renamed into place: a crash never leaves a half-written cache.
-    const std::string temporary = file + ".tmp";
-    {
-      std::ofstream out(temporary, std::ios::binary);
-      out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-      if (!out)
-        throw_error("Multiresolution: cannot write the MT file '", temporary, "'.");
-    }
-    std::error_code error;
-    std::filesystem::rename(temporary, file, error);
-    if (error)
-      throw_error("Multiresolution: cannot write the MT file '", file, "'.");
+    // Replaced atomically: a crash or a full disk never leaves a half-written cache.
+    write_file_atomically(file, buffer);
   }
 
 

@@ -1,11 +1,11 @@
 // Postprocessor `statistics`: one row per step in statistics.csv.
 
-#include <lacerta/base/exceptions.h>
+#include <lacerta/base/output_file.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/postprocess/postprocessor.h>
 
+#include <algorithm>
 #include <cstdio>
-#include <fstream>
 
 namespace lacerta::postprocess
 {
@@ -32,16 +32,13 @@ namespace lacerta::postprocess
       void
       initialize(const std::string &output_directory, const bool test) override
       {
-        file_name = output_directory + "/statistics.csv";
-        file.open(file_name);
-        if (!file)
-          throw_error("Cannot write '", file_name, "'.");
+        file      = OutputFile(output_directory + "/statistics.csv");
         test_mode = test;
-        file
-          << "step,time,time_step,substeps,kinetic_energy,elastic_energy,"
-             "body_force_energy,input_work,force_wall_s,step_wall_s,mesh_size,cut_tets,"
-             "created_tets,update_wall_ms,over_limit,tears,torn_tets,tear_created_tets,"
-             "tear_wall_ms,split_fragments,mt_update_wall_ms,cut_step_wall_ms\n";
+        file.append(
+          "step,time,time_step,substeps,kinetic_energy,elastic_energy,"
+          "body_force_energy,input_work,force_wall_s,step_wall_s,mesh_size,cut_tets,"
+          "created_tets,update_wall_ms,over_limit,tears,torn_tets,tear_created_tets,"
+          "tear_wall_ms,split_fragments,mt_update_wall_ms,cut_step_wall_ms\n");
       }
 
       bool
@@ -53,40 +50,42 @@ namespace lacerta::postprocess
       void
       execute(const RunState &s) override
       {
-        char line[640];
-        std::snprintf(line,
-                      sizeof(line),
-                      "%u,%.9g,%.6g,%u,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%u,%u,%u,%.6g,%u,%u,"
-                      "%u,%u,%.6g,%u,%.6g,%.6g\n",
-                      s.step,
-                      s.time,
-                      s.time_step,
-                      s.substeps,
-                      s.kinetic_energy,
-                      s.elastic_energy,
-                      s.body_force_energy,
-                      s.input_work,
-                      test_mode ? 0.0 : s.force_seconds,
-                      test_mode ? 0.0 : s.step_seconds,
-                      s.mesh->n_tets(),
-                      s.cut_tets,
-                      s.created_tets,
-                      test_mode ? 0.0 : 1e3 * s.update_seconds,
-                      s.over_limit,
-                      s.tears,
-                      s.torn_tets,
-                      s.tear_created_tets,
-                      test_mode ? 0.0 : 1e3 * s.tear_seconds,
-                      s.split_fragments,
-                      test_mode ? 0.0 : 1e3 * s.mt_update_seconds,
-                      test_mode ? 0.0 : 1e3 * s.cut_step_seconds);
-        file << line;
+        char      line[640];
+        const int length = std::snprintf(
+          line,
+          sizeof(line),
+          "%u,%.9g,%.6g,%u,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%u,%u,%u,%.6g,%u,%u,"
+          "%u,%u,%.6g,%u,%.6g,%.6g\n",
+          s.step,
+          s.time,
+          s.time_step,
+          s.substeps,
+          s.kinetic_energy,
+          s.elastic_energy,
+          s.body_force_energy,
+          s.input_work,
+          test_mode ? 0.0 : s.force_seconds,
+          test_mode ? 0.0 : s.step_seconds,
+          s.mesh->n_tets(),
+          s.cut_tets,
+          s.created_tets,
+          test_mode ? 0.0 : 1e3 * s.update_seconds,
+          s.over_limit,
+          s.tears,
+          s.torn_tets,
+          s.tear_created_tets,
+          test_mode ? 0.0 : 1e3 * s.tear_seconds,
+          s.split_fragments,
+          test_mode ? 0.0 : 1e3 * s.mt_update_seconds,
+          test_mode ? 0.0 : 1e3 * s.cut_step_seconds);
+        file.append(
+          std::string_view(line,
+                           std::min(static_cast<std::size_t>(length), sizeof(line) - 1)));
       }
 
     private:
-      std::string   file_name;
-      std::ofstream file;
-      bool          test_mode = false;
+      OutputFile file;
+      bool       test_mode = false;
     };
   } // namespace
 

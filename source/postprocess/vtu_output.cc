@@ -1,6 +1,7 @@
 // Postprocessor `vtu`: VTU files and a PVD time series for ParaView.
 
 #include <lacerta/base/exceptions.h>
+#include <lacerta/base/output_file.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/postprocess/postprocessor.h>
@@ -18,7 +19,7 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 
 namespace lacerta::postprocess
 {
@@ -152,19 +153,24 @@ namespace lacerta::postprocess
         for (auto *array : {cell_strain.Get(), cell_density.Get(), cell_modulus.Get()})
           grid->GetCellData()->AddArray(array);
 
+        // The file is composed in memory and then replaced atomically, like the
+        // series after it: a write that fails leaves every earlier file and the series
+        // that lists them valid.
         char name[64];
         std::snprintf(name, sizeof(name), "solution-%05u.vtu", n_written);
         vtkNew<vtkXMLUnstructuredGridWriter> writer;
-        writer->SetFileName((directory + "/" + name).c_str());
+        writer->WriteToOutputStringOn();
         writer->SetInputData(grid);
         writer->SetDataModeToAppended();
         writer->SetCompressorTypeToZLib();
         if (writer->Write() != 1)
-          throw_error("Cannot write '", directory, "/", name, "'.");
+          throw_error(
+            "Cannot write '", directory, "/", name, "': VTK failed to encode it.");
+        write_file_atomically(directory + "/" + name, writer->GetOutputString());
         ++n_written;
 
         series.emplace_back(s.time, name);
-        std::ofstream pvd(directory + "/solution.pvd");
+        std::ostringstream pvd;
         pvd.precision(12);
         pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n "
                " <Collection>\n";
@@ -172,6 +178,7 @@ namespace lacerta::postprocess
           pvd << "    <DataSet timestep=\"" << time << "\" group=\"\" part=\"0\" file=\""
               << file << "\"/>\n";
         pvd << "  </Collection>\n</VTKFile>\n";
+        write_file_atomically(directory + "/solution.pvd", pvd.str());
       }
 
       double                                      interval    = 0;

@@ -1,5 +1,6 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/input_path.h>
+#include <lacerta/base/output_file.h>
 #include <lacerta/cut/cutter.h>
 #include <lacerta/cut/invariants.h>
 #include <lacerta/cut/lacerator.h>
@@ -24,6 +25,7 @@
 #include <fstream>
 #include <iostream>
 #include <numeric>
+#include <sstream>
 #include <unistd.h>
 
 namespace lacerta
@@ -282,13 +284,11 @@ namespace lacerta
     const unsigned int redistribution_reach = prm.get_integer("Redistribution reach");
     prm.leave_subsection();
 
-    std::error_code error;
-    std::filesystem::create_directories(output_directory, error);
-    std::ofstream copy(output_directory + "/parameters.prm");
-    if (error || !copy)
-      throw_error("Cannot create the output directory '", output_directory, "'.");
+    create_output_directory(output_directory);
+    std::ostringstream copy;
     copy << "# Parameters used by lacerta for " << parameter_file << "\n";
     prm.print_parameters(copy, dealii::ParameterHandler::ShortPRM);
+    write_file_atomically(output_directory + "/parameters.prm", copy.str());
 
     scene          = std::make_unique<scene::Scene>(prm, n_threads);
     integrator     = physics::Integrator::create(prm);
@@ -510,7 +510,7 @@ namespace lacerta
         state.update_seconds = cut.update_seconds;
         state.cut_step_seconds =
           cut.search_seconds + cut.update_seconds + cut.reinit_seconds;
-        cut_changed          = cut.changed;
+        cut_changed = cut.changed;
         stroke_cut += cut.cut_tets;
         stroke_created += cut.created_tets;
         stroke_update += cut.update_seconds;
