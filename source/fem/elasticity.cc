@@ -25,6 +25,7 @@
 #include <deal.II/lac/trilinos_sparsity_pattern.h>
 #include <deal.II/lac/trilinos_vector.h>
 
+#include <Epetra_CrsMatrix.h>
 #include <algorithm>
 #include <cmath>
 
@@ -33,6 +34,36 @@ namespace lacerta::fem
   using namespace dealii;
   using VectorType = TrilinosWrappers::MPI::Vector;
   using MatrixType = TrilinosWrappers::SparseMatrix;
+
+  namespace
+  {
+    /**
+     * dst = A src through Epetra. TrilinosWrappers::SparseMatrix::vmult is a template
+     * whose enable_if return type gcc and clang mangle differently, so code compiled by
+     * clang (the fuzzing build, doc/reliability.md) could not call the instance in
+     * Debian's gcc-built deal.II; Epetra's Multiply is a plain member function.
+     */
+    void
+    multiply(const MatrixType &a, VectorType &dst, const VectorType &src)
+    {
+      const int error =
+        a.trilinos_matrix().Multiply(false, src.trilinos_vector(), dst.trilinos_vector());
+      AssertThrow(error == 0, MatrixType::ExcTrilinosError(error));
+    }
+
+
+    /// A matrix that SolverCG multiplies with through multiply().
+    struct EpetraOperator
+    {
+      const MatrixType &matrix;
+
+      void
+      vmult(VectorType &dst, const VectorType &src) const
+      {
+        multiply(matrix, dst, src);
+      }
+    };
+  } // namespace
 
   void
   SolverParameters::declare_parameters(ParameterHandler &prm)
@@ -417,7 +448,7 @@ namespace lacerta::fem
     ensure_layout(residual);
     ensure_layout(correction);
     ensure_layout(result);
-    full.vmult(residual, u_d);
+    multiply(full, residual, u_d);
     residual.sadd(-1.0, 1.0, f);
     constraints.set_zero(residual);
     // The tolerance is relative to this right-hand side, not to the initial residual:
@@ -433,7 +464,7 @@ namespace lacerta::fem
       SolverCG<VectorType> cg(control);
       try
       {
-        cg.solve(constrained, correction, residual, preconditioner);
+        cg.solve(EpetraOperator{constrained}, correction, residual, preconditioner);
       }
       catch (const SolverControl::NoConvergence &e)
       {
@@ -567,7 +598,7 @@ namespace lacerta::fem
     VectorType f;
     s.load(0, f);
     VectorType ku(s.owned, s.communicator);
-    s.stiffness.vmult(ku, s.u);
+    multiply(s.stiffness, ku, s.u);
     f -= ku;
     VectorType zero(s.owned, s.communicator);
     MatrixType constrained_mass;
@@ -603,11 +634,11 @@ namespace lacerta::fem
     s.damped *= a1;
     s.damped += s.v;
     s.work.add(c, s.damped);
-    s.mass.vmult(s.product, s.work);
+    multiply(s.mass, s.product, s.work);
     s.rhs += s.product;
     if (beta > 0)
     {
-      s.stiffness.vmult(s.product, s.damped);
+      multiply(s.stiffness, s.product, s.damped);
       s.rhs.add(beta, s.product);
     }
 
@@ -674,13 +705,13 @@ namespace lacerta::fem
         return;
       SolverControl        control(quiet.max_iterations, quiet.tolerance * src.l2_norm());
       SolverCG<VectorType> cg(control);
-      cg.solve(s.constrained_stiffness, dst, src, s.stiffness_amg);
+      cg.solve(EpetraOperator{s.constrained_stiffness}, dst, src, s.stiffness_amg);
     };
     return to_frequencies(lowest_eigenvalues<VectorType>(
       n,
       start,
-      [&](VectorType &dst, const VectorType &src) { s.stiffness.vmult(dst, src); },
-      [&](VectorType &dst, const VectorType &src) { s.mass.vmult(dst, src); },
+      [&](VectorType &dst, const VectorType &src) { multiply(s.stiffness, dst, src); },
+      [&](VectorType &dst, const VectorType &src) { multiply(s.mass, dst, src); },
       solve_k,
       [&](VectorType &x) { s.constraints.set_zero(x); }));
   }

@@ -475,8 +475,9 @@ TEST(CutCutter, CrackThatOpensBehindTheFrontStillSeparates)
       "y = " + std::to_string(y) + ", " + std::to_string(n) + " steps";
     std::mt19937 rng(8);
     CutFixture   f(4, rng, vertical(-0.2, y));
-    f.after_step = [&](const cut::CutStepStatistics &)
-    { open_crack(f.mesh, *f.system, y, opening); };
+    // Copies: a lambda cannot capture a structured binding in C++17.
+    f.after_step = [&f, plane = y, width = opening](const cut::CutStepStatistics &)
+    { open_crack(f.mesh, *f.system, plane, width); };
     // The rest plane moves by less than ε of an edge (0.05 * 0.25): the field keeps
     // y fixed, and snapping moves the surface by at most that.
     expect_straight_cut_into_two(f, y, n, y, 0.0125, where);
