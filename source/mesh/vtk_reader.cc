@@ -134,51 +134,105 @@ namespace lacerta::mesh
 
 
     /**
-     * VTK's legacy reader stops at a coordinate written as `nan` or `inf` with
-     * "Unrecognized keyword", which names neither the point nor the line: look at the
-     * POINTS of an ASCII file first. Other problems are left to VTK.
+     * The header lines of an ASCII legacy file that carry counts, checked before VTK
+     * reads it: VTK's legacy reader trusts them and reads on from a failed stream
+     * (a `CELLS` line without its two counts crashes it). Every `POINTS`, `CELLS`,
+     * `CELL_TYPES`, `CELL_DATA`, `POINT_DATA` and `FIELD` line must carry its counts as
+     * non-negative integers. VTK also stops at a
+     * coordinate written as `nan` or `inf` with "Unrecognized keyword", which names
+     * neither the point nor the line: the POINTS are checked here too. Other problems
+     * are left to VTK.
      */
-    void
-    check_legacy_points(const std::string &file_name)
+    class LegacyHeaderCheck
     {
-      std::ifstream in(file_name);
-      std::string   line;
-      std::size_t   line_number = 0;
-      for (; line_number < 3 && std::getline(in, line); ++line_number)
-        if (line_number == 2 && line.rfind("ASCII", 0) != 0)
-          return;
-      std::size_t n_points = 0;
-      while (n_points == 0 && std::getline(in, line))
+    public:
+      explicit LegacyHeaderCheck(const std::string &file_name)
+          : file_name(file_name)
       {
-        ++line_number;
-        std::istringstream tokens(line);
-        std::string        keyword;
-        if (tokens >> keyword && keyword == "POINTS" && !(tokens >> n_points))
-          return;
       }
-      std::size_t coordinate = 0;
-      while (coordinate < 3 * n_points && std::getline(in, line))
+
+      void
+      run()
       {
-        ++line_number;
-        std::istringstream tokens(line);
-        for (std::string token; coordinate < 3 * n_points && tokens >> token;
-             ++coordinate)
+        std::ifstream in(file_name);
+        std::string   line;
+        for (; line_number < 3 && std::getline(in, line); ++line_number)
+          if (line_number == 2 && line.rfind("ASCII", 0) != 0)
+            return;
+        while (std::getline(in, line))
         {
-          char        *rest = nullptr;
-          const double x    = std::strtod(token.c_str(), &rest);
-          if (rest == token.c_str() || *rest != '\0' || !std::isfinite(x))
-            throw_error("Mesh file '",
-                        file_name,
-                        "', line ",
-                        line_number,
-                        ": point ",
-                        coordinate / 3,
-                        " has a coordinate that is not a finite number ('",
-                        token,
-                        "').");
+          ++line_number;
+          std::istringstream tokens(line);
+          std::string        keyword;
+          if (!(tokens >> keyword))
+            continue;
+          if (keyword == "POINTS")
+            check_points(in, count(tokens, keyword, "the number of points"));
+          else if (keyword == "CELLS")
+          {
+            count(tokens, keyword, "the number of cells");
+            count(tokens, keyword, "the size of the cell list");
+          }
+          else if (keyword == "CELL_TYPES" || keyword == "CELL_DATA")
+            count(tokens, keyword, "the number of cells");
+          else if (keyword == "POINT_DATA")
+            count(tokens, keyword, "the number of points");
+          else if (keyword == "FIELD")
+          {
+            std::string name;
+            tokens >> name;
+            count(tokens, keyword, "the number of arrays");
+          }
         }
       }
-    }
+
+    private:
+      [[noreturn]] void
+      fail(const std::string &what) const
+      {
+        throw_error("Mesh file '", file_name, "', line ", line_number, ": ", what, ".");
+      }
+
+      // The next token of @p tokens as a count, or an Error naming @p what.
+      std::size_t
+      count(std::istringstream &tokens,
+            const std::string  &keyword,
+            const char         *what) const
+      {
+        std::string token;
+        tokens >> token;
+        char                    *rest  = nullptr;
+        const unsigned long long value = std::strtoull(token.c_str(), &rest, 10);
+        if (token.empty() || token[0] == '-' || *rest != '\0' || value > (1ull << 40))
+          fail(keyword + " must give " + what + " as a non-negative integer, not '"
+               + token + "'");
+        return static_cast<std::size_t>(value);
+      }
+
+      void
+      check_points(std::ifstream &in, const std::size_t n_points)
+      {
+        std::size_t coordinate = 0;
+        std::string line;
+        while (coordinate < 3 * n_points && std::getline(in, line))
+        {
+          ++line_number;
+          std::istringstream tokens(line);
+          for (std::string token; coordinate < 3 * n_points && tokens >> token;
+               ++coordinate)
+          {
+            char        *rest = nullptr;
+            const double x    = std::strtod(token.c_str(), &rest);
+            if (rest == token.c_str() || *rest != '\0' || !std::isfinite(x))
+              fail("point " + std::to_string(coordinate / 3)
+                   + " has a coordinate that is not a finite number ('" + token + "')");
+          }
+        }
+      }
+
+      const std::string file_name;
+      std::size_t       line_number = 0;
+    };
 
 
     /// "hexahedron" for VTK_HEXAHEDRON: VTK's class name without its prefix.
@@ -200,7 +254,7 @@ namespace lacerta::mesh
     if (!std::ifstream(file_name))
       throw_error("Mesh file '", file_name, "' cannot be opened.");
     if (!ends_with(file_name, ".vtu"))
-      check_legacy_points(file_name);
+      LegacyHeaderCheck(file_name).run();
 
     const vtkSmartPointer<vtkUnstructuredGrid> grid = read_grid(file_name);
     if (grid == nullptr || grid->GetNumberOfPoints() == 0)
