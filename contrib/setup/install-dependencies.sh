@@ -17,10 +17,12 @@ $SUDO apt-get update
 #  libeigen3-dev     small dense algebra, eigenvalue checks in tests
 #  libgtest-dev, libbenchmark-dev   unit tests and benchmarks
 #  python3-matplotlib  study plots (error against run time)
+#  clang-14, libclang-rt-14-dev   the sanitizer and fuzzing build (libFuzzer)
 $SUDO apt-get install -y --no-install-recommends \
   build-essential cmake ninja-build git \
   libdeal.ii-dev \
   numdiff perl openmpi-bin libopenmpi-dev \
   libvtk9-dev libcgal-dev libeigen3-dev \
   libgtest-dev libbenchmark-dev \
-  clang-format python3 python3-matplotlib
+  clang-format python3 python3-matplotlib \
+  clang-14 libclang-rt-14-dev

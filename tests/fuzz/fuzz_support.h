@@ -1,0 +1,60 @@
+// What the libFuzzer targets share: the input as a file, and the rule for what counts
+// as a finding.
+#pragma once
+
+#include <lacerta/base/exceptions.h>
+
+#include <deal.II/base/exceptions.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <unistd.h>
+
+namespace lacerta::fuzz
+{
+  /**
+   * Writes @p size bytes at @p data to a file of this process with the extension
+   * @p extension (the readers choose their format by it) and returns its name.
+   */
+  inline std::string
+  input_file(const std::uint8_t *data,
+             const std::size_t   size,
+             const std::string  &extension)
+  {
+    const char       *directory = std::getenv("TMPDIR");
+    const std::string name      = std::string(directory ? directory : "/tmp")
+                             + "/lacerta-fuzz-" + std::to_string(::getpid()) + extension;
+    std::FILE *file = std::fopen(name.c_str(), "wb");
+    if (file == nullptr)
+      std::abort();
+    if (size > 0 && std::fwrite(data, 1, size, file) != size)
+      std::abort();
+    std::fclose(file);
+    return name;
+  }
+
+
+  /**
+   * Runs @p action on an input: the clear errors Lacerta promises for bad input (an
+   * Error, or a deal.II exception naming the entry) are the expected outcome; anything
+   * else (a crash, a sanitizer report, another exception, an abort) is a finding.
+   */
+  template <typename Action>
+  void
+  expect_clean(const Action &action)
+  {
+    try
+    {
+      action();
+    }
+    catch (const lacerta::Error &)
+    {
+    }
+    catch (const dealii::ExceptionBase &)
+    {
+    }
+  }
+} // namespace lacerta::fuzz
