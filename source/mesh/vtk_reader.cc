@@ -138,7 +138,9 @@ namespace lacerta::mesh
      * reads it: VTK's legacy reader trusts them and reads on from a failed stream
      * (a `CELLS` line without its two counts crashes it). Every `POINTS`, `CELLS`,
      * `CELL_TYPES`, `CELL_DATA`, `POINT_DATA` and `FIELD` line must carry its counts as
-     * non-negative integers. VTK also stops at a
+     * non-negative integers; the cell list and the cell types must hold as many
+     * integers as they announce (a short or non-numeric list crashes VTK too). VTK
+     * also stops at a
      * coordinate written as `nan` or `inf` with "Unrecognized keyword", which names
      * neither the point nor the line: the POINTS are checked here too. Other problems
      * are left to VTK.
@@ -170,10 +172,15 @@ namespace lacerta::mesh
             check_points(in, count(tokens, keyword, "the number of points"));
           else if (keyword == "CELLS")
           {
-            count(tokens, keyword, "the number of cells");
-            count(tokens, keyword, "the size of the cell list");
+            const std::size_t n    = count(tokens, keyword, "the number of cells");
+            const std::size_t size = count(tokens, keyword, "the size of the cell list");
+            check_cell_list(in, n, size);
           }
-          else if (keyword == "CELL_TYPES" || keyword == "CELL_DATA")
+          else if (keyword == "CELL_TYPES")
+            check_integers(in,
+                           count(tokens, keyword, "the number of cells"),
+                           "CELL_TYPES");
+          else if (keyword == "CELL_DATA")
             count(tokens, keyword, "the number of cells");
           else if (keyword == "POINT_DATA")
             count(tokens, keyword, "the number of points");
@@ -209,6 +216,61 @@ namespace lacerta::mesh
         return static_cast<std::size_t>(value);
       }
 
+      // The next integer of the file after the current line's tokens, or an Error
+      // naming @p section.
+      long long
+      next_integer(std::ifstream &in, const char *section)
+      {
+        std::string token;
+        while (!(pending >> token))
+        {
+          std::string line;
+          if (!std::getline(in, line))
+            fail(std::string(section) + " ends before all its values (truncated?)");
+          ++line_number;
+          pending = std::istringstream(line);
+        }
+        char           *rest  = nullptr;
+        const long long value = std::strtoll(token.c_str(), &rest, 10);
+        if (token.empty() || *rest != '\0')
+          fail(std::string(section) + " holds '" + token + "' where an integer belongs");
+        return value;
+      }
+
+      void
+      check_integers(std::ifstream &in, const std::size_t n, const char *section)
+      {
+        pending = std::istringstream();
+        for (std::size_t i = 0; i < n; ++i)
+          next_integer(in, section);
+      }
+
+      // The cell list of the legacy format before version 5: @p n records "k i_1 ..
+      // i_k" in @p size integers. (Version 5 writes OFFSETS and CONNECTIVITY arrays
+      // instead, which VTK reads as data arrays.)
+      void
+      check_cell_list(std::ifstream &in, const std::size_t n, const std::size_t size)
+      {
+        pending = std::istringstream();
+        if (in.peek() == 'O')
+          return;
+        std::size_t read = 0;
+        for (std::size_t record = 0; record < n; ++record)
+        {
+          const long long k = next_integer(in, "CELLS");
+          if (k < 0 || read + 1 + static_cast<std::size_t>(k) > size)
+            fail("CELLS: cell " + std::to_string(record) + " has " + std::to_string(k)
+                 + " vertices, more than the list's size " + std::to_string(size)
+                 + " leaves");
+          for (long long i = 0; i < k; ++i)
+            next_integer(in, "CELLS");
+          read += 1 + static_cast<std::size_t>(k);
+        }
+        if (read != size)
+          fail("CELLS: the " + std::to_string(n) + " cells take " + std::to_string(read)
+               + " integers, not the size " + std::to_string(size) + " it gives");
+      }
+
       void
       check_points(std::ifstream &in, const std::size_t n_points)
       {
@@ -230,8 +292,9 @@ namespace lacerta::mesh
         }
       }
 
-      const std::string file_name;
-      std::size_t       line_number = 0;
+      const std::string  file_name;
+      std::size_t        line_number = 0;
+      std::istringstream pending;
     };
 
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <lacerta/base/exceptions.h>
+#include <lacerta/mesh/tet_mesh.h>
 
 #include <deal.II/base/exceptions.h>
 
@@ -56,5 +57,22 @@ namespace lacerta::fuzz
     catch (const dealii::ExceptionBase &)
     {
     }
+  }
+
+
+  /**
+   * A mesh that a reader accepted is usable: every neighbour index is in range (else
+   * abort, a finding).
+   */
+  inline void
+  check_usable(const mesh::TetMesh &m)
+  {
+    for (unsigned int t = 0; t < m.n_tets(); ++t)
+      for (unsigned int f = 0; f < 4; ++f)
+      {
+        const unsigned int n = m.neighbor(t, f);
+        if (n != mesh::invalid_index && n >= m.n_tets())
+          std::abort();
+      }
   }
 } // namespace lacerta::fuzz
