@@ -61,6 +61,21 @@ namespace lacerta::fuzz
 
 
   /**
+   * Writes the input to a file with the extension @p extension (input_file()) and runs
+   * @p read on its name under expect_clean(): what every file-reading target does.
+   */
+  template <typename Read>
+  void
+  read_clean(const std::uint8_t *data,
+             const std::size_t   size,
+             const std::string  &extension,
+             const Read         &read)
+  {
+    const std::string file = input_file(data, size, extension);
+    expect_clean([&] { read(file); });
+  }
+
+  /**
    * A mesh that a reader accepted is usable: every neighbour index is in range (else
    * abort, a finding).
    */

@@ -10,12 +10,13 @@ extern "C" int
 LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size)
 {
   using namespace lacerta;
-  const std::string file = fuzz::input_file(data, size, ".msh");
-  fuzz::expect_clean(
-    [&]
-    {
-      mesh::check_gmsh_file(file);
-      fuzz::check_usable(mesh::read_gmsh(file));
-    });
+  fuzz::read_clean(data,
+                   size,
+                   ".msh",
+                   [](const std::string &file)
+                   {
+                     mesh::check_gmsh_file(file);
+                     fuzz::check_usable(mesh::read_gmsh(file));
+                   });
   return 0;
 }

@@ -12,12 +12,13 @@ extern "C" int
 LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size)
 {
   using namespace lacerta;
-  const std::string file = fuzz::input_file(data, size, ".prm");
-  fuzz::expect_clean(
-    [&]
-    {
-      dealii::ParameterHandler prm;
-      Simulator::read_parameters(file, prm);
-    });
+  fuzz::read_clean(data,
+                   size,
+                   ".prm",
+                   [](const std::string &file)
+                   {
+                     dealii::ParameterHandler prm;
+                     Simulator::read_parameters(file, prm);
+                   });
   return 0;
 }

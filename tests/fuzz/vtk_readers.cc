@@ -15,6 +15,12 @@ LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size)
   using namespace lacerta;
   if (size < 1)
     return 0;
+  fuzz::read_clean(data + 1,
+                   size - 1,
+                   data[0] % 2 ? ".vtu" : ".vtk",
+                   [](const std::string &file)
+                   { fuzz::check_usable(mesh::read_vtk_unstructured_grid(file)); });
+  return 0;
   const std::string file =
     fuzz::input_file(data + 1, size - 1, data[0] % 2 ? ".vtu" : ".vtk");
   fuzz::expect_clean([&] { fuzz::check_usable(mesh::read_vtk_unstructured_grid(file)); });
