@@ -1,6 +1,7 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/input_path.h>
 #include <lacerta/mesh/vtk_reader.h>
+#include <lacerta/mesh/vtk_xml_check.h>
 
 #include <vtkCellData.h>
 #include <vtkCellType.h>
@@ -168,27 +169,30 @@ namespace lacerta::mesh
           std::string        keyword;
           if (!(tokens >> keyword))
             continue;
-          if (keyword == "POINTS")
+          if (is_keyword(keyword, "points"))
             check_points(in, count(tokens, keyword, "the number of points"));
-          else if (keyword == "CELLS")
+          else if (is_keyword(keyword, "cells"))
           {
             const std::size_t n    = count(tokens, keyword, "the number of cells");
             const std::size_t size = count(tokens, keyword, "the size of the cell list");
             check_cell_list(in, n, size);
           }
-          else if (keyword == "CELL_TYPES")
+          else if (is_keyword(keyword, "cell_types"))
             check_integers(in,
                            count(tokens, keyword, "the number of cells"),
                            "CELL_TYPES");
-          else if (keyword == "CELL_DATA")
+          else if (is_keyword(keyword, "cell_data"))
             count(tokens, keyword, "the number of cells");
-          else if (keyword == "POINT_DATA")
+          else if (is_keyword(keyword, "point_data"))
             count(tokens, keyword, "the number of points");
-          else if (keyword == "FIELD")
+          else if (is_keyword(keyword, "field"))
           {
             std::string name;
             tokens >> name;
-            count(tokens, keyword, "the number of arrays");
+            const std::size_t n_arrays = count(tokens, keyword, "the number of arrays");
+            pending                    = std::istringstream();
+            for (std::size_t a = 0; a < n_arrays; ++a)
+              check_field_array(in);
           }
         }
       }
@@ -198,6 +202,15 @@ namespace lacerta::mesh
       fail(const std::string &what) const
       {
         throw_error("Mesh file '", file_name, "', line ", line_number, ": ", what, ".");
+      }
+
+      /// Whether VTK takes @p token for the keyword @p lower_case: it compares the
+      /// token's first letters, in lower case ("CELLSTYPES" is a CELLS line to VTK).
+      static bool
+      is_keyword(std::string token, const std::string &lower_case)
+      {
+        std::transform(token.begin(), token.end(), token.begin(), ::tolower);
+        return token.compare(0, lower_case.size(), lower_case) == 0;
       }
 
       // The next token of @p tokens as a count, or an Error naming @p what.
@@ -216,25 +229,52 @@ namespace lacerta::mesh
         return static_cast<std::size_t>(value);
       }
 
-      // The next integer of the file after the current line's tokens, or an Error
+      // The next token of the file after the current line's tokens, or an Error
       // naming @p section.
-      long long
-      next_integer(std::ifstream &in, const char *section)
+      std::string
+      next_token(std::ifstream &in, const std::string &section)
       {
         std::string token;
         while (!(pending >> token))
         {
           std::string line;
           if (!std::getline(in, line))
-            fail(std::string(section) + " ends before all its values (truncated?)");
+            fail(section + " ends before all its values (truncated?)");
           ++line_number;
           pending = std::istringstream(line);
         }
-        char           *rest  = nullptr;
-        const long long value = std::strtoll(token.c_str(), &rest, 10);
+        return token;
+      }
+
+      // The next integer of the file after the current line's tokens, or an Error
+      // naming @p section.
+      long long
+      next_integer(std::ifstream &in, const char *section)
+      {
+        const std::string token = next_token(in, section);
+        char             *rest  = nullptr;
+        const long long   value = std::strtoll(token.c_str(), &rest, 10);
         if (token.empty() || *rest != '\0')
           fail(std::string(section) + " holds '" + token + "' where an integer belongs");
         return value;
+      }
+
+      // One array of a FIELD: "name components tuples type", then its values (skipped
+      // here, so that an array name is not taken for a keyword).
+      void
+      check_field_array(std::ifstream &in)
+      {
+        const std::string name = next_token(in, "FIELD");
+        if (name == "NULL_ARRAY")
+          return;
+        std::istringstream header(next_token(in, "FIELD") + " "
+                                  + next_token(in, "FIELD"));
+        const std::string  section = "FIELD array '" + name + "'";
+        const std::size_t  values  = count(header, section, "its number of components")
+                                   * count(header, section, "its number of tuples");
+        next_token(in, section);
+        for (std::size_t i = 0; i < values; ++i)
+          next_token(in, section);
       }
 
       void
@@ -316,7 +356,9 @@ namespace lacerta::mesh
   {
     if (!std::ifstream(file_name))
       throw_error("Mesh file '", file_name, "' cannot be opened.");
-    if (!ends_with(file_name, ".vtu"))
+    if (ends_with(file_name, ".vtu"))
+      check_vtk_xml_file(file_name);
+    else
       LegacyHeaderCheck(file_name).run();
 
     const vtkSmartPointer<vtkUnstructuredGrid> grid = read_grid(file_name);
@@ -345,6 +387,20 @@ namespace lacerta::mesh
     vtkDataArray *ids = grid->GetCellData()->GetArray("boundary_id");
     if (ids == nullptr)
       ids = grid->GetCellData()->GetArray("gmsh:physical");
+    if (ids != nullptr
+        && (ids->GetNumberOfComponents() != 1
+            || ids->GetNumberOfTuples() != grid->GetNumberOfCells()))
+      throw_error("Mesh file '",
+                  file_name,
+                  "': the cell array '",
+                  ids->GetName(),
+                  "' must hold one value per cell (",
+                  grid->GetNumberOfCells(),
+                  "), not ",
+                  ids->GetNumberOfTuples(),
+                  " tuples of ",
+                  ids->GetNumberOfComponents(),
+                  ".");
 
     std::vector<Tet>              tets;
     std::vector<TetMesh::FaceTag> tags;
@@ -362,6 +418,17 @@ namespace lacerta::mesh
                       " refers to point ",
                       points->GetId(i),
                       ", which does not exist (truncated file?).");
+      if ((type == VTK_TETRA && points->GetNumberOfIds() != 4)
+          || (type == VTK_TRIANGLE && points->GetNumberOfIds() != 3))
+        throw_error("Mesh file '",
+                    file_name,
+                    "': cell ",
+                    c,
+                    " (",
+                    cell_type_name(type),
+                    ") has ",
+                    points->GetNumberOfIds(),
+                    " vertices.");
       if (type == VTK_TETRA)
       {
         const Tet cell = {static_cast<unsigned int>(points->GetId(0)),

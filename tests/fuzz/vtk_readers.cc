@@ -1,8 +1,6 @@
 // libFuzzer target: the VTK readers (legacy and XML) on arbitrary files. The first byte
 // chooses the format (even: legacy .vtk, odd: .vtu), the rest is the file. A malformed
 // file must be an Error naming it; a crash or a sanitizer report is a finding.
-// Not yet run by CTest: VTK's readers still crash on some malformed files
-// (doc/reliability.md, "Fuzzing").
 
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/mesh/vtk_reader.h>
@@ -20,9 +18,5 @@ LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size)
                    data[0] % 2 ? ".vtu" : ".vtk",
                    [](const std::string &file)
                    { fuzz::check_usable(mesh::read_vtk_unstructured_grid(file)); });
-  return 0;
-  const std::string file =
-    fuzz::input_file(data + 1, size - 1, data[0] % 2 ? ".vtu" : ".vtk");
-  fuzz::expect_clean([&] { fuzz::check_usable(mesh::read_vtk_unstructured_grid(file)); });
   return 0;
 }
