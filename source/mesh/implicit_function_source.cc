@@ -8,18 +8,25 @@
 
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/function_parser.h>
-#include <deal.II/cgal/additional_data.h>
-#include <deal.II/grid/grid_generator.h>
+#include <deal.II/cgal/triangulation.h>
+#include <deal.II/cgal/utilities.h>
 #include <deal.II/grid/tria.h>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Labeled_mesh_domain_3.h>
+#include <CGAL/Mesh_complex_3_in_triangulation_3.h>
+#include <CGAL/Mesh_criteria_3.h>
+#include <CGAL/Mesh_triangulation_3.h>
+#include <CGAL/make_mesh_3.h>
 
 namespace lacerta::mesh
 {
   namespace
   {
-    /// The parser's own explanation from a deal.II exception, without the code location.
     /**
      * The volume where an implicit function is negative, meshed with tetrahedra by
-     * CGAL's Mesh_3 through GridGenerator::implicit_function.
+     * CGAL's Mesh_3 (as deal.II's GridGenerator::implicit_function does, but with the
+     * mesh optimisers run to completion; see mesh_with_cgal()).
      */
     class ImplicitFunctionSource : public MeshSource
     {
@@ -96,18 +103,52 @@ namespace lacerta::mesh
             f_inside,
             ").");
 
-        dealii::CGALWrappers::AdditionalData<3> data;
-        data.cell_size              = cell_size;
-        data.facet_size             = facet_size;
-        data.facet_distance         = facet_distance;
-        data.cell_radius_edge_ratio = cell_radius_edge_ratio;
-        dealii::Triangulation<3> triangulation;
-        dealii::GridGenerator::implicit_function(
-          triangulation, *function, data, inside, outer_ball_radius);
-        return tet_mesh_from_triangulation(triangulation, "implicit function");
+        return tet_mesh_from_triangulation(mesh_with_cgal(*function, inside),
+                                           "implicit function");
       }
 
     private:
+      /**
+       * CGAL's Mesh_3 on {f < 0}. The sliver perturbation and the exudation that follow
+       * the refinement are given no time limit: by default CGAL stops them after as
+       * much wall time as the refinement took, so the mesh depended on the machine's
+       * load and differed from run to run at fine sizes. Run to completion, they make
+       * the mesh a function of the parameters alone.
+       */
+      dealii::Triangulation<3>
+      mesh_with_cgal(const dealii::Function<3> &function,
+                     const dealii::Point<3>    &inside) const
+      {
+        using Kernel   = CGAL::Exact_predicates_inexact_constructions_kernel;
+        using Domain   = CGAL::Labeled_mesh_domain_3<Kernel>;
+        using Tr       = CGAL::Mesh_triangulation_3<Domain,
+                                              CGAL::Default,
+                                              dealii::CGALWrappers::ConcurrencyTag>::type;
+        using C3t3     = CGAL::Mesh_complex_3_in_triangulation_3<Tr, int, int>;
+        using Criteria = CGAL::Mesh_criteria_3<Tr>;
+        namespace p    = CGAL::parameters;
+
+        const auto f = [&function](const Kernel::Point_3 &x)
+        { return Kernel::FT(function.value(dealii::Point<3>(x.x(), x.y(), x.z()))); };
+        const Domain domain = Domain::create_implicit_mesh_domain(
+          f,
+          Kernel::Sphere_3(Kernel::Point_3(inside[0], inside[1], inside[2]),
+                           outer_ball_radius * outer_ball_radius));
+        const Criteria           criteria(p::facet_size             = facet_size,
+                                p::facet_angle            = 0.,
+                                p::facet_distance         = facet_distance,
+                                p::cell_radius_edge_ratio = cell_radius_edge_ratio,
+                                p::cell_size              = cell_size);
+        const C3t3               complex = CGAL::make_mesh_3<C3t3>(domain,
+                                                     criteria,
+                                                     p::perturb(p::time_limit = 0),
+                                                     p::exude(p::time_limit = 0));
+        dealii::Triangulation<3> triangulation;
+        dealii::CGALWrappers::cgal_triangulation_to_dealii_triangulation(complex,
+                                                                         triangulation);
+        return triangulation;
+      }
+
       std::string           expression;
       std::array<double, 3> interior_point{};
       double                outer_ball_radius = 0, cell_size = 0, facet_size = 0;
