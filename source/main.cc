@@ -28,37 +28,18 @@ main(int argc, char **argv)
     return 2;
   }
 
-  try
-  {
-    dealii::ParameterHandler prm;
-    lacerta::Simulator::read_parameters(argv[1], prm);
-    if (prm.get("Mode") == "study")
-      lacerta::fem::Study(prm).run();
-    else
+  return lacerta::run_reporting_errors(
+    [&]
     {
-      lacerta::Simulator simulator(prm, argv[1]);
-      simulator.run();
-    }
-  }
-  catch (const lacerta::Error &e)
-  {
-    std::cout.flush();
-    std::cerr << "\nError: " << e.what() << std::endl;
-    return 1;
-  }
-  catch (const dealii::ExceptionBase &e)
-  {
-    std::cout.flush();
-    std::cerr << "\nError: ";
-    e.print_info(std::cerr);
-    std::cerr << std::endl;
-    return 1;
-  }
-  catch (const std::exception &e)
-  {
-    std::cout.flush();
-    std::cerr << "\nError: " << e.what() << std::endl;
-    return 1;
-  }
-  return 0;
+      dealii::ParameterHandler prm;
+      lacerta::Simulator::read_parameters(argv[1], prm);
+      if (prm.get("Mode") == "study")
+        lacerta::fem::Study(prm).run();
+      else
+      {
+        lacerta::Simulator simulator(prm, argv[1]);
+        simulator.run();
+      }
+      return 0;
+    });
 }

@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -36,4 +37,12 @@ namespace lacerta
     (message << ... << pieces);
     throw Error(message.str());
   }
+
+  /**
+   * Runs a program's @p body and returns its exit code; an Error, a deal.II exception
+   * or any other std::exception it throws is printed as `Error: <message>` on standard
+   * error and gives exit code 1. The `main` of every Lacerta program.
+   */
+  int
+  run_reporting_errors(const std::function<int()> &body);
 } // namespace lacerta
