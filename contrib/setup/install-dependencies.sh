@@ -18,6 +18,9 @@ $SUDO apt-get update
 #  libgtest-dev, libbenchmark-dev   unit tests and benchmarks
 #  python3-matplotlib  study plots (error against run time)
 #  clang-14, libclang-rt-14-dev   the sanitizer and fuzzing build (libFuzzer)
+#  xvfb, xauth       a virtual X display: Debian's VTK renders (lacerta-view, the png
+#                    postprocessor) only with an X server, and the tests run under
+#                    xvfb-run
 $SUDO apt-get install -y --no-install-recommends \
   build-essential cmake ninja-build git \
   libdeal.ii-dev \
@@ -25,4 +28,5 @@ $SUDO apt-get install -y --no-install-recommends \
   libvtk9-dev libcgal-dev libeigen3-dev \
   libgtest-dev libbenchmark-dev \
   clang-format python3 python3-matplotlib \
-  clang-14 libclang-rt-14-dev
+  clang-14 libclang-rt-14-dev \
+  xvfb xauth

@@ -14,6 +14,7 @@
 #include <lacerta/postprocess/postprocessor.h>
 #include <lacerta/scene/scene.h>
 #include <lacerta/simulator/simulator.h>
+#include <lacerta/view/viewer.h>
 
 #include <deal.II/base/timer.h>
 #include <deal.II/base/utilities.h>
@@ -209,6 +210,7 @@ namespace lacerta
     physics::Integrator::declare_parameters(prm);
     postprocess::Postprocessor::declare_parameters(prm);
     fem::Study::declare_parameters(prm);
+    view::Viewer::declare_parameters(prm);
   }
 
 
@@ -412,6 +414,7 @@ namespace lacerta
     state.mesh     = &scene->active_mesh();
     state.system   = &system;
     state.material = &scene->material;
+    state.blade    = scene->cutter ? &scene->cutter->blade() : nullptr;
     state.substeps = substeps;
 
     // After a topology change or a new level of detail the particles and springs are
@@ -476,6 +479,8 @@ namespace lacerta
       dealii::TimerOutput::Scope scope(timer, "output");
       for (auto &p : postprocessors)
         p->execute(state);
+      if (signals.post_step)
+        signals.post_step(state);
     };
 
     postprocess(0);
@@ -488,7 +493,8 @@ namespace lacerta
     double             last_progress = 0;
     std::cout << "Running " << n_steps << " steps\n";
 
-    double time = 0;
+    double       time       = 0;
+    unsigned int steps_done = 0;
     for (unsigned int step = 1; step <= n_steps; ++step)
     {
       const double dt         = std::min(time_step, end_time - time);
@@ -502,9 +508,12 @@ namespace lacerta
       bool cut_changed                                                           = false;
       if (scene->cutter)
       {
-        dealii::TimerOutput::Scope   scope(timer, "cut");
+        dealii::TimerOutput::Scope scope(timer, "cut");
+        std::optional<cut::Blade>  blade;
+        if (signals.blade)
+          blade = signals.blade(time + dt);
         const cut::CutStepStatistics cut =
-          scene->cutter->move_blade(scene->tool->blade(time + dt));
+          scene->cutter->move_blade(blade ? *blade : scene->tool->blade(time + dt));
         state.cut_tets       = cut.cut_tets;
         state.created_tets   = cut.created_tets;
         state.update_seconds = cut.update_seconds;
@@ -617,12 +626,15 @@ namespace lacerta
       }
       if (scene->update_level_of_detail(time, step, std::cout))
         system_changed(step, time, false, "the re-extraction of the level of detail");
-      state.step          = step;
-      state.time          = time;
+      state.step = step;
+      state.time = time;
+      // The cutter is made anew after a tear (Scene::restart_cutter()).
+      state.blade         = scene->cutter ? &scene->cutter->blade() : nullptr;
       state.time_step     = dt;
       state.step_seconds  = seconds_since(step_start);
       state.force_seconds = system.force_seconds;
       postprocess(step);
+      steps_done = step;
 
       if (step * n_reports / n_steps != (step - 1) * n_reports / n_steps
           || step == n_steps)
@@ -647,11 +659,13 @@ namespace lacerta
                      100.0 * step / n_steps,
                      elapsed * (n_steps - step) / step);
       }
+      if (signals.stop && signals.stop())
+        break;
     }
     if (show_progress && last_progress > 0)
       std::fprintf(stderr, "\n");
 
-    std::cout << "Done: " << n_steps << " steps, " << n_integrator_steps
+    std::cout << "Done: " << steps_done << " steps, " << n_integrator_steps
               << " integrator steps\n";
     if (mass_balancer && n_balances > 0)
     {

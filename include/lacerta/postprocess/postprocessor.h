@@ -22,6 +22,10 @@ namespace lacerta::scene
 {
   class Material;
 }
+namespace lacerta::cut
+{
+  struct Blade;
+}
 
 namespace lacerta::postprocess
 {
@@ -33,6 +37,8 @@ namespace lacerta::postprocess
     const mesh::TetMesh           *mesh     = nullptr;
     const physics::ParticleSystem *system   = nullptr;
     const scene::Material         *material = nullptr;
+    /// Where the scalpel's blade is, or nullptr in a scene without a tool.
+    const cut::Blade *blade = nullptr;
     /// Step number (0 before the first step).
     unsigned int step = 0;
     /// Simulated time (s).

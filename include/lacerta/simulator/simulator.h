@@ -4,10 +4,14 @@
  */
 #pragma once
 
+#include <lacerta/cut/tool.h>
+
 #include <deal.II/base/parameter_handler.h>
 
+#include <functional>
 #include <iosfwd>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,10 +27,28 @@ namespace lacerta::physics
 namespace lacerta::postprocess
 {
   class Postprocessor;
-}
+  struct RunState;
+} // namespace lacerta::postprocess
 
 namespace lacerta
 {
+  /**
+   * Hooks into the main loop for a program that drives a scene interactively
+   * (lacerta-view), after ASPECT's SimulatorSignals. Each is optional; the simulation
+   * thread calls them.
+   */
+  struct SimulatorSignals
+  {
+    /// The blade at the end of the step that ends at time t, instead of the tool's
+    /// (nullopt: the tool's).
+    std::function<std::optional<cut::Blade>(double t)> blade;
+    /// Called once before the first step and after every step, with what the
+    /// postprocessors see.
+    std::function<void(const postprocess::RunState &)> post_step;
+    /// Asked after every step: true ends the run there, as if at the end time.
+    std::function<bool()> stop;
+  };
+
   /**
    * Runs a scene: builds it from the parameters, integrates it in time with stability
    * control, and calls the postprocessors.
@@ -66,6 +88,9 @@ namespace lacerta
     /// Runs the scene to its end time; throws an Error if the run cannot go on.
     void
     run();
+
+    /// Hooks for an interactive driver; set them before run().
+    SimulatorSignals signals;
 
     /// The scene, e.g. to read the final state after run().
     const scene::Scene &
