@@ -36,7 +36,7 @@ case "$mode" in
     export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
     cmake -S "$top" -B "$asan" -G Ninja -DCMAKE_BUILD_TYPE=Release \
       -DCMAKE_CXX_COMPILER=clang++-14 -DLACERTA_SANITIZE=ON -DLACERTA_FUZZ=ON
-    cmake --build "$asan" --parallel "$(nproc)" --target lacerta lacerta-unit-tests \
+    cmake --build "$asan" --parallel "$(nproc)" --target lacerta lacerta-view lacerta-unit-tests \
       lacerta-bench lacerta-fuzz-gmsh_reader lacerta-fuzz-vtk_readers \
       lacerta-fuzz-parameter_file lacerta-fuzz-cutter
     ctest --test-dir "$asan" --parallel "$(nproc)" --output-on-failure --timeout 900
