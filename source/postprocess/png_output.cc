@@ -4,6 +4,7 @@
 #include <lacerta/base/output_file.h>
 #include <lacerta/base/parameter_utilities.h>
 #include <lacerta/cut/tool.h>
+#include <lacerta/postprocess/output_schedule.h>
 #include <lacerta/postprocess/postprocessor.h>
 #include <lacerta/view/scene_picture.h>
 
@@ -86,18 +87,18 @@ namespace lacerta::postprocess
       void
       parse_parameters(dealii::ParameterHandler &prm) override
       {
-        interval  = prm.get_double("Time between pictures");
+        schedule.set_interval(prm.get_double("Time between pictures"));
         field     = view::field_from_name(prm.get("Field"));
         width     = prm.get_integer("Width");
         height    = prm.get_integer("Height");
         wireframe = prm.get_bool("Wireframe");
         title     = prm.get("Title");
-        range     = parse_triple_or_pair(prm.get("Colour range"), 2, "Colour range");
+        range     = parse_numbers(prm.get("Colour range"), 2, "Colour range");
         if (range && !((*range)[1] > (*range)[0]))
           throw_error("Postprocess/Png/Colour range: the high end must be above the "
                       "low end.");
         const auto position =
-          parse_triple_or_pair(prm.get("Camera position"), 3, "Camera position");
+          parse_numbers(prm.get("Camera position"), 3, "Camera position");
         if (position)
           camera.position = {{(*position)[0], (*position)[1], (*position)[2]}};
         camera.focal_point = get_point(prm, "Focal point");
@@ -118,7 +119,7 @@ namespace lacerta::postprocess
       bool
       writes_state(const double time) const override
       {
-        return time >= next_picture - 1e-12 * std::max(1.0, std::abs(time));
+        return schedule.due(time);
       }
 
       void
@@ -147,16 +148,15 @@ namespace lacerta::postprocess
         std::snprintf(name, sizeof(name), "picture-%05u.png", n_written);
         write_file_atomically(directory + "/" + name, view::png_of_window(window));
         ++n_written;
-        next_picture =
-          interval > 0 ? (std::floor(s.time / interval + 1e-9) + 1) * interval : s.time;
+        schedule.written(s.time);
       }
 
     private:
       /// @p count numbers separated by commas in @p text, or nothing if it is empty.
       static std::optional<std::array<double, 3>>
-      parse_triple_or_pair(const std::string &text,
-                           const unsigned int count,
-                           const std::string &entry)
+      parse_numbers(const std::string &text,
+                    const unsigned int count,
+                    const std::string &entry)
       {
         if (text.find_first_not_of(" \t") == std::string::npos)
           return std::nullopt;
@@ -181,7 +181,7 @@ namespace lacerta::postprocess
         return values;
       }
 
-      double                               interval = 0, next_picture = 0;
+      OutputSchedule                       schedule;
       view::Field                          field = view::Field::displacement;
       unsigned int                         width = 800, height = 600, n_written = 0;
       bool                                 wireframe = false;

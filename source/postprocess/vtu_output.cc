@@ -4,6 +4,8 @@
 #include <lacerta/base/output_file.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/spring_strain.h>
+#include <lacerta/postprocess/output_schedule.h>
 #include <lacerta/postprocess/postprocessor.h>
 #include <lacerta/scene/material.h>
 
@@ -59,7 +61,7 @@ namespace lacerta::postprocess
       void
       parse_parameters(dealii::ParameterHandler &prm) override
       {
-        interval = prm.get_double("Time between outputs");
+        schedule.set_interval(prm.get_double("Time between outputs"));
       }
 
       void
@@ -71,7 +73,7 @@ namespace lacerta::postprocess
       bool
       writes_state(const double time) const override
       {
-        return time >= next_output - 1e-12 * std::max(1.0, std::abs(time));
+        return schedule.due(time);
       }
 
       void
@@ -80,8 +82,7 @@ namespace lacerta::postprocess
         if (!writes_state(s.time))
           return;
         write(s);
-        next_output =
-          interval > 0 ? (std::floor(s.time / interval + 1e-9) + 1) * interval : s.time;
+        schedule.written(s.time);
       }
 
     private:
@@ -113,13 +114,7 @@ namespace lacerta::postprocess
         // Springs are the mesh's edges, in the same order.
         std::vector<double> strain(system.springs.size());
         for (std::size_t e = 0; e < strain.size(); ++e)
-        {
-          const double *a = &system.position[3 * system.springs.a[e]];
-          const double *b = &system.position[3 * system.springs.b[e]];
-          strain[e]       = std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2])
-                        / system.springs.rest_length[e]
-                      - 1.0;
-        }
+          strain[e] = physics::spring_strain(system, static_cast<unsigned int>(e));
 
         vtkNew<vtkCellArray> cells;
         auto                 cell_strain  = make_array("spring_strain", 1, mesh.n_tets());
@@ -181,9 +176,8 @@ namespace lacerta::postprocess
         write_file_atomically(directory + "/solution.pvd", pvd.str());
       }
 
-      double                                      interval    = 0;
-      double                                      next_output = 0;
-      unsigned int                                n_written   = 0;
+      OutputSchedule                              schedule;
+      unsigned int                                n_written = 0;
       std::string                                 directory;
       std::vector<std::pair<double, std::string>> series;
     };

@@ -1,6 +1,7 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/spring_strain.h>
 #include <lacerta/view/surface_field.h>
 
 #include <vtkCellArray.h>
@@ -18,18 +19,6 @@ namespace lacerta::view
 {
   namespace
   {
-    /// Elongation over rest length of spring @p e at the current positions.
-    double
-    spring_strain(const physics::ParticleSystem &system, const unsigned int e)
-    {
-      const double *a = &system.position[3 * system.springs.a[e]];
-      const double *b = &system.position[3 * system.springs.b[e]];
-      return std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2])
-               / system.springs.rest_length[e]
-             - 1.0;
-    }
-
-
     /// The longest rest edge of tetrahedron @p t.
     double
     longest_rest_edge(const mesh::TetMesh &mesh, const unsigned int t)
@@ -117,7 +106,8 @@ namespace lacerta::view
           const auto &ends = mesh::TetMesh::edge_vertices[e];
           if (ends[0] == face.face || ends[1] == face.face)
             continue;
-          const double strain = spring_strain(system, mesh.tet_edges(face.tet)[e]);
+          const double strain =
+            physics::spring_strain(system, mesh.tet_edges(face.tet)[e]);
           if (std::abs(strain) > std::abs(largest))
             largest = strain;
         }

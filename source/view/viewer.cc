@@ -373,7 +373,6 @@ namespace lacerta::view
     std::array<double, 3> eye;
     camera->GetPosition(eye.data());
     view_direction = mesh::normalized(mesh::sub(press_point, eye));
-    held           = true;
     scalpel->press(press_point, view_direction);
   }
 
@@ -388,7 +387,6 @@ namespace lacerta::view
   void
   Viewer::release()
   {
-    held = false;
     scalpel->release();
   }
 
@@ -396,7 +394,7 @@ namespace lacerta::view
   bool
   Viewer::cutting() const
   {
-    return held;
+    return scalpel->held();
   }
 
 
@@ -513,12 +511,11 @@ namespace lacerta::view
     if (!snapshot || !snapshot->surface)
       return;
     ++n_frames;
-    static Clock::time_point last = Clock::now();
-    if (seconds_since(last) >= 1)
+    if (seconds_since(fps_since) >= 1)
     {
-      fps      = n_frames / seconds_since(last);
-      n_frames = 0;
-      last     = Clock::now();
+      fps       = n_frames / seconds_since(fps_since);
+      n_frames  = 0;
+      fps_since = Clock::now();
     }
     std::ostringstream title;
     title << std::fixed << std::setprecision(3) << "t = " << snapshot->time << " s   "

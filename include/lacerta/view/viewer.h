@@ -11,6 +11,7 @@
 #include <deal.II/base/parameter_handler.h>
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
@@ -140,11 +141,12 @@ namespace lacerta::view
     std::string                   error;
     double                        object_size = 1;
     std::array<double, 3>         press_point{}, view_direction{};
-    bool                          held          = false;
     unsigned int                  n_screenshots = 0, n_frames = 0;
-    double                        fps = 0;
-    std::vector<Event>            events;
-    std::size_t                   next_event = 0;
+    /// Frames per second, counted since `fps_since`.
+    double                                fps       = 0;
+    std::chrono::steady_clock::time_point fps_since = std::chrono::steady_clock::now();
+    std::vector<Event>                    events;
+    std::size_t                           next_event = 0;
     /// The time of the next scripted event: the simulation waits there until the
     /// viewer's thread has injected it, so that a script gives the same run each time.
     std::atomic<double>        next_event_time{1e300};
