@@ -9,7 +9,6 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <map>
 #include <set>
@@ -195,13 +194,9 @@ TEST(MeshSources, AllFormatsGiveTheSameMesh)
 
 TEST(MeshSources, ImplicitFunctionDefaultIsAValidOrgan)
 {
-  const auto    start = std::chrono::steady_clock::now();
-  const TetMesh mesh  = mesh_from_source("implicit function", {});
-  const double  seconds =
-    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // The defaults aim at a few thousand tetrahedra in well under a second (0.1 s on
-  // the development machine); the bound leaves room for a slow test machine.
-  EXPECT_LT(seconds, 5.0);
+  // The defaults aim at a few thousand tetrahedra (0.1 s on the development
+  // machine; not timed here: the test machines are shared).
+  const TetMesh mesh = mesh_from_source("implicit function", {});
   EXPECT_GE(mesh.n_tets(), 2000u);
   EXPECT_LE(mesh.n_tets(), 10000u);
   double smallest = 1e300;
