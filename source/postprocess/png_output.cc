@@ -7,6 +7,7 @@
 #include <lacerta/postprocess/output_schedule.h>
 #include <lacerta/postprocess/postprocessor.h>
 #include <lacerta/view/scene_picture.h>
+#include <lacerta/view/x_display.h>
 
 #include <deal.II/base/utilities.h>
 
@@ -16,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 namespace lacerta::postprocess
@@ -25,7 +27,7 @@ namespace lacerta::postprocess
     /**
      * Renders the tissue's surface, coloured by a field with a colour bar and a title
      * that gives the time, as picture-NNNNN.png, offscreen (under an X display: see
-     * view::require_display()).
+     * view::XDisplay).
      */
     class PngOutput : public Postprocessor
     {
@@ -108,7 +110,8 @@ namespace lacerta::postprocess
       void
       initialize(const std::string &output_directory, bool) override
       {
-        view::require_display("The png postprocessor");
+        display.emplace("The png postprocessor");
+        display->attach(*window);
         directory = output_directory;
         window->SetOffScreenRendering(1);
         window->SetSize(static_cast<int>(width), static_cast<int>(height));
@@ -189,7 +192,9 @@ namespace lacerta::postprocess
       std::optional<std::array<double, 3>> range;
       view::Camera                         camera;
       view::ScenePicture                   picture;
-      vtkNew<vtkRenderWindow>              window;
+      /// Declared before the window, which must go first.
+      std::optional<view::XDisplay> display;
+      vtkNew<vtkRenderWindow>       window;
     };
   } // namespace
 

@@ -24,9 +24,7 @@
 #include <vtkUnsignedCharArray.h>
 #include <vtkWindowToImageFilter.h>
 
-#include <X11/Xlib.h>
 #include <cmath>
-#include <cstdlib>
 
 // VTK's implementations behind vtkRenderWindow, the text and the interactor styles,
 // registered here rather than by CMake's vtk_module_autoinit(), which would put its
@@ -38,24 +36,6 @@ VTK_MODULE_INIT(vtkRenderingUI);
 
 namespace lacerta::view
 {
-  void
-  require_display(const std::string &who)
-  {
-    const char *name = std::getenv("DISPLAY");
-    Display *display = name != nullptr && *name != '\0' ? XOpenDisplay(nullptr) : nullptr;
-    if (display == nullptr)
-      throw_error(who,
-                  " needs an X display to render on (Debian's VTK renders through X, "
-                  "even offscreen), and ",
-                  name == nullptr || *name == '\0'
-                    ? std::string("DISPLAY is not set")
-                    : "DISPLAY = '" + std::string(name) + "' cannot be opened",
-                  ". On a machine without a screen, run under a virtual one: "
-                  "xvfb-run -a <command>.");
-    XCloseDisplay(display);
-  }
-
-
   ScenePicture::ScenePicture()
   {
     renderer_->SetBackground(1, 1, 1);

@@ -7,6 +7,7 @@
 #include <lacerta/simulator/simulator.h>
 #include <lacerta/view/scene_picture.h>
 #include <lacerta/view/viewer.h>
+#include <lacerta/view/x_display.h>
 
 #include <vtkActor.h>
 #include <vtkCallbackCommand.h>
@@ -545,11 +546,13 @@ namespace lacerta::view
   int
   Viewer::run()
   {
-    require_display("lacerta-view");
+    // Declared before the window, which must go first.
+    const XDisplay display("lacerta-view");
     picture = std::make_unique<ScenePicture>();
     start_simulation();
 
     vtkNew<vtkRenderWindow> render_window;
+    display.attach(*render_window);
     render_window->SetSize(static_cast<int>(options.width),
                            static_cast<int>(options.height));
     render_window->SetWindowName(("lacerta-view " + options.scene_file).c_str());

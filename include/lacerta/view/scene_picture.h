@@ -36,14 +36,6 @@ namespace lacerta::view
   };
 
   /**
-   * Throws an Error if there is no X display to render on: Debian's VTK renders through
-   * X, even offscreen. @p who names what needs it, for the message, which says to run
-   * under `xvfb-run -a` on a machine without a screen.
-   */
-  void
-  require_display(const std::string &who);
-
-  /**
    * The tissue's surface coloured by a field, with a colour bar, a title line, the
    * blade as a segment and, on request, the mesh's surface edges (the wireframe that
    * shows the level of detail). show() takes a new state; the renderer draws it in any
