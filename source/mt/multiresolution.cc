@@ -1,6 +1,7 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/parameter_utilities.h>
 #include <lacerta/base/parsed_function.h>
+#include <lacerta/cut/tool.h>
 #include <lacerta/mt/cut_state_transfer.h>
 #include <lacerta/mt/multiresolution.h>
 
@@ -33,6 +34,14 @@ namespace lacerta::mt
                       dealii::Patterns::Anything(),
                       "Position of the tool the level of detail follows, as a function "
                       "of t: three expressions separated by ';' [m].");
+    prm.declare_entry("Focus follows",
+                      "path",
+                      dealii::Patterns::Selection("path|tool"),
+                      "What the level of detail follows. path: the point of 'Focus "
+                      "path' at time t. tool: the scalpel's blade (the scene's tool, or "
+                      "the mouse in lacerta-view): the middle of its part inside the "
+                      "object's bounding box at rest, or the point of the box nearest "
+                      "to it.");
     prm.declare_entry("Re-extraction distance",
                       "0.005",
                       dealii::Patterns::Double(0.0, 1e3),
@@ -84,11 +93,17 @@ namespace lacerta::mt
 
   Multiresolution::Multiresolution(dealii::ParameterHandler        &prm,
                                    const mesh::TetMesh             &input,
-                                   const std::vector<unsigned int> &locked)
+                                   const std::vector<unsigned int> &locked,
+                                   const cut::Blade                *blade)
   {
     prm.enter_subsection("Multiresolution");
     const std::string directory = prm.get("Cache directory");
     path = parse_function("Multiresolution/Focus path", prm.get("Focus path"), 3, true);
+    follows_tool = prm.get("Focus follows") == "tool";
+    if (follows_tool && blade == nullptr)
+      throw_error(
+        "Multiresolution/Focus follows = tool: the scene has no tool to follow; set "
+        "'Tool/Type' to a tool or 'Focus follows = path'.");
     distance = prm.get_double("Re-extraction distance");
     interval = prm.get_integer("Re-extraction interval");
     query    = LodQueryRegistry::create_and_parse(prm.get("Query"), prm);
@@ -101,9 +116,18 @@ namespace lacerta::mt
     prm.leave_subsection();
     boundary_error = parameters.maximum_boundary_error;
 
+    box_low  = {{1e300, 1e300, 1e300}};
+    box_high = {{-1e300, -1e300, -1e300}};
+    for (const mesh::Point3 &x : input.get_vertices())
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        box_low[d]  = std::min(box_low[d], x[d]);
+        box_high[d] = std::max(box_high[d], x[d]);
+      }
+
     mt         = load_or_build(input, parameters, locked, directory, cache);
     lod        = std::make_unique<Lod>(mt);
-    last_focus = focus(0);
+    last_focus = focus(0, blade);
     query->set_focus(last_focus);
     lod->extract(*query);
     make_active_mesh();
@@ -114,18 +138,82 @@ namespace lacerta::mt
 
 
   mesh::Point3
-  Multiresolution::focus(const double time) const
+  Multiresolution::focus(const double time, const cut::Blade *blade) const
   {
+    if (follows_tool && blade != nullptr)
+      return focus_of_blade(*blade);
     const dealii::Point<3> origin;
     path->set_time(time);
     return {{path->value(origin, 0), path->value(origin, 1), path->value(origin, 2)}};
   }
 
 
-  bool
-  Multiresolution::update(const double time, const unsigned int step)
+  mesh::Point3
+  Multiresolution::focus_of_blade(const cut::Blade &blade) const
   {
-    const mesh::Point3 now = focus(time);
+    const mesh::Point3 along = mesh::sub(blade.head, blade.tail);
+    // The part of the segment inside the box: the parameter interval [enter, leave]
+    // that every slab between two faces of the box keeps.
+    double enter = 0, leave = 1;
+    for (unsigned int d = 0; d < 3 && enter <= leave; ++d)
+    {
+      if (along[d] == 0)
+      {
+        if (blade.tail[d] < box_low[d] || blade.tail[d] > box_high[d])
+          leave = -1;
+        continue;
+      }
+      double a = (box_low[d] - blade.tail[d]) / along[d];
+      double b = (box_high[d] - blade.tail[d]) / along[d];
+      if (a > b)
+        std::swap(a, b);
+      enter = std::max(enter, a);
+      leave = std::min(leave, b);
+    }
+    if (enter <= leave)
+      return mesh::lerp(blade.tail, blade.head, 0.5 * (enter + leave));
+    // Outside: the point of the box nearest to the blade. The distance to the box is
+    // convex along the segment, so a golden-section search finds the blade's point
+    // nearest to the box, which is then moved onto the box.
+    const auto distance_to_box = [this](const mesh::Point3 &x)
+    {
+      double squared = 0;
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        const double out = std::max({box_low[d] - x[d], 0.0, x[d] - box_high[d]});
+        squared += out * out;
+      }
+      return squared;
+    };
+    const double ratio = 0.5 * (std::sqrt(5.0) - 1);
+    double       low = 0, high = 1;
+    for (unsigned int i = 0; i < 80; ++i)
+    {
+      const double s1 = high - ratio * (high - low), s2 = low + ratio * (high - low);
+      if (distance_to_box(mesh::lerp(blade.tail, blade.head, s1))
+          <= distance_to_box(mesh::lerp(blade.tail, blade.head, s2)))
+        high = s2;
+      else
+        low = s1;
+    }
+    double best = 0.5 * (low + high);
+    for (const double end : {0.0, 1.0})
+      if (distance_to_box(mesh::lerp(blade.tail, blade.head, end))
+          <= distance_to_box(mesh::lerp(blade.tail, blade.head, best)))
+        best = end;
+    mesh::Point3 nearest = mesh::lerp(blade.tail, blade.head, best);
+    for (unsigned int d = 0; d < 3; ++d)
+      nearest[d] = std::clamp(nearest[d], box_low[d], box_high[d]);
+    return nearest;
+  }
+
+
+  bool
+  Multiresolution::update(const double       time,
+                          const unsigned int step,
+                          const cut::Blade  *blade)
+  {
+    const mesh::Point3 now = focus(time, blade);
     const double       moved =
       std::hypot(now[0] - last_focus[0], now[1] - last_focus[1], now[2] - last_focus[2]);
     if (moved <= distance && step - last_step < interval)

@@ -47,6 +47,7 @@ namespace lacerta::scene
     constraints = Constraint::create(prm, mesh);
     for (auto &constraint : constraints)
       has_varying_loads |= !constraint->prescribes_motion();
+    tool = cut::Tool::create(prm);
     if (mt::Multiresolution::enabled(prm))
     {
       // Constrained particles stay in every level of detail: the scene holds them.
@@ -57,13 +58,17 @@ namespace lacerta::scene
                       constraint->particles.end());
       std::sort(locked.begin(), locked.end());
       locked.erase(std::unique(locked.begin(), locked.end()), locked.end());
-      multiresolution = std::make_unique<mt::Multiresolution>(prm, mesh, locked);
+      const std::optional<cut::Blade> blade =
+        tool ? std::optional<cut::Blade>(tool->blade(0.0)) : std::nullopt;
+      multiresolution = std::make_unique<mt::Multiresolution>(prm,
+                                                              mesh,
+                                                              locked,
+                                                              blade ? &*blade : nullptr);
     }
     system = std::make_unique<physics::ParticleSystem>(std::vector<double>());
     assemble(active_mesh(), 0.0);
     system->set_force_model(physics::ForceModel::create(prm), n_threads);
     initial_volume    = mesh.total_volume();
-    tool              = cut::Tool::create(prm);
     cutter_parameters = cut::Cutter::parse_parameters(prm);
     if (tool)
     {
@@ -257,7 +262,7 @@ namespace lacerta::scene
     if (!multiresolution || cut_pending())
       return false;
     const std::vector<std::uint32_t> old_vertices = multiresolution->active_vertices();
-    if (!multiresolution->update(t, step))
+    if (!multiresolution->update(t, step, cutter ? &cutter->blade() : nullptr))
       return false;
     move_to_level_of_detail(
       t,

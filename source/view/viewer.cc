@@ -216,6 +216,15 @@ namespace lacerta::view
     prm.enter_subsection("Tool");
     const bool has_tool = prm.get("Type") != "none";
     prm.leave_subsection();
+    // The level of detail follows the scalpel, wherever the mouse takes it.
+    const auto follow_the_tool = [this]
+    {
+      prm.enter_subsection("Multiresolution");
+      prm.set("Focus follows", "tool");
+      prm.leave_subsection();
+    };
+    if (has_tool)
+      follow_the_tool();
     simulator                  = std::make_unique<Simulator>(prm, options.scene_file);
     const mesh::TetMesh  &mesh = simulator->get_scene().active_mesh();
     std::array<double, 3> low{{1e300, 1e300, 1e300}}, high{{-1e300, -1e300, -1e300}};
@@ -241,6 +250,7 @@ namespace lacerta::view
       prm.set("Keyframes", keys.str());
       prm.leave_subsection();
       prm.leave_subsection();
+      follow_the_tool();
       simulator = std::make_unique<Simulator>(prm, options.scene_file);
     }
     scalpel = std::make_unique<MouseScalpel>(blade_parameters, object_size);

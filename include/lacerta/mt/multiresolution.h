@@ -26,14 +26,20 @@ namespace dealii
   class FunctionParser;
 }
 
+namespace lacerta::cut
+{
+  struct Blade;
+}
+
 namespace lacerta::mt
 {
   /**
    * Owns the MT of a scene's mesh (from the cache or built), the current level of
    * detail and its mesh, and decides when to re-extract: when the focus (a point moving
-   * along `Focus path`) has moved more than `Re-extraction distance` since the last
-   * extraction, or every `Re-extraction interval` steps. Only scenes with
-   * `Multiresolution/Enabled = true` create one.
+   * along `Focus path`, or with `Focus follows = tool` following the scalpel's blade) has
+   * moved more than `Re-extraction distance` since the last extraction, or every
+   * `Re-extraction interval` steps. Only scenes with `Multiresolution/Enabled = true`
+   * create one.
    */
   class Multiresolution
   {
@@ -48,20 +54,24 @@ namespace lacerta::mt
 
     /**
      * Builds or loads the MT of @p mesh (whose @p locked vertices are never removed)
-     * and extracts the level of detail for the focus at time 0.
+     * and extracts the level of detail for the focus at time 0: on the path, or with
+     * `Focus follows = tool` at @p blade, the tool's blade at time 0 (an error if there
+     * is none).
      */
     Multiresolution(dealii::ParameterHandler        &prm,
                     const mesh::TetMesh             &mesh,
-                    const std::vector<unsigned int> &locked);
+                    const std::vector<unsigned int> &locked,
+                    const cut::Blade                *blade);
 
     ~Multiresolution();
 
     /**
      * Re-extracts if the focus at time @p time (step @p step) has moved far enough or
-     * the interval has passed; returns whether the level of detail changed.
+     * the interval has passed; returns whether the level of detail changed. With
+     * `Focus follows = tool` the focus is at @p blade, the blade where the tool now is.
      */
     bool
-    update(double time, unsigned int step);
+    update(double time, unsigned int step, const cut::Blade *blade);
 
     /// The mesh of the current level of detail (vertices numbered compactly).
     const mesh::TetMesh &
@@ -141,9 +151,21 @@ namespace lacerta::mt
       return mt;
     }
 
-    /// The focus at time @p time.
+    /**
+     * The focus at time @p time: on `Focus path`, or with `Focus follows = tool`
+     * focus_of_blade() of @p blade.
+     */
     mesh::Point3
-    focus(double time) const;
+    focus(double time, const cut::Blade *blade) const;
+
+    /**
+     * Where a blade puts the focus: the middle of the part of the segment inside the
+     * bounding box of the mesh at rest, or, if it misses the box, the point of the box
+     * nearest to it. The blade's world coordinates are taken as rest coordinates, which the
+     * level of detail's fine region (a few cells around the focus) tolerates.
+     */
+    mesh::Point3
+    focus_of_blade(const cut::Blade &blade) const;
 
   private:
     /// Rebuilds the mesh and the vertex list from the Lod.
@@ -156,8 +178,12 @@ namespace lacerta::mt
     std::unique_ptr<Lod>                       lod;
     std::unique_ptr<LodQuery>                  query;
     std::unique_ptr<dealii::FunctionParser<3>> path;
-    double                                     distance = 0;
-    unsigned int                               interval = 1;
+    /// `Focus follows = tool`: the focus follows the blade, not the path.
+    bool follows_tool = false;
+    /// The bounding box of the mesh at rest (lowest and highest corner).
+    mesh::Point3 box_low{}, box_high{};
+    double       distance = 0;
+    unsigned int interval = 1;
     /// The builder's `Maximum boundary error`, which the MT's cuts must reach past.
     double        boundary_error = 0.01;
     mesh::Point3  last_focus{};

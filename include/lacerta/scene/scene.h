@@ -61,11 +61,11 @@ namespace lacerta::scene
 
     /**
      * With multiresolution: re-extracts the level of detail if the focus at time @p t
-     * (step @p step) asks for it and, if it changed, rebuilds the particle system on it
-     * with the particles' state carried over (Section 4.2), writing a line to @p out;
-     * the cutter, if any, restarts on it. Postponed while a cut waits for its MT
-     * update (update_multiresolution_after_cut()). Returns whether the particle system
-     * changed; without multiresolution, false.
+     * (step @p step; with `Focus follows = tool` the cutter's blade) asks for it and, if
+     * it changed, rebuilds the particle system on it with the particles' state carried
+     * over (Section 4.2), writing a line to @p out; the cutter, if any, restarts on it.
+     * Postponed while a cut waits for its MT update (update_multiresolution_after_cut()).
+     * Returns whether the particle system changed; without multiresolution, false.
      */
     bool
     update_level_of_detail(double t, unsigned int step, std::ostream &out);
