@@ -16,7 +16,7 @@ namespace
   usage(std::ostream &out)
   {
     out << "Usage: lacerta-view [--record stroke.prm] [--events events.txt] "
-           "[--size WIDTHxHEIGHT] scene.prm\n"
+           "[--size WIDTHxHEIGHT] [--benchmark] scene.prm\n"
            "  Runs the scene in real time in a window; the left mouse button cuts "
            "(Ctrl or\n  Shift + left button, or a press beside the tissue, turns the "
            "camera).\n"
@@ -24,7 +24,9 @@ namespace
            "        - slower, + faster, q quit (doc/viewer.md).\n"
            "  --record FILE  writes the blade's path at exit as a parameter file that\n"
            "                 replays it in batch: lacerta FILE\n"
-           "  --events FILE  injects scripted mouse and key events (doc/viewer.md)\n";
+           "  --events FILE  injects scripted mouse and key events (doc/viewer.md)\n"
+           "  --benchmark    drags a scripted stroke across the middle of the window in\n"
+           "                 real time and prints the frame rate and real-time factor\n";
   }
 } // namespace
 
@@ -45,7 +47,9 @@ main(int argc, char **argv)
       usage(std::cout);
       return 0;
     }
-    if ((arg == "--record" || arg == "--events" || arg == "--size") && i + 1 < argc)
+    if (arg == "--benchmark")
+      options.benchmark = true;
+    else if ((arg == "--record" || arg == "--events" || arg == "--size") && i + 1 < argc)
     {
       const std::string value = argv[++i];
       if (arg == "--record")

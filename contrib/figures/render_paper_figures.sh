@@ -2,7 +2,8 @@
 # Renders the paper's Figures 8 to 11 from Lacerta's scenes with the png postprocessor
 # (doc/viewer.md) into doc/images/figure-*.png: the square pulled and cut, the punched
 # hole, the kidney's cuts on the level of detail, the tear. Each scene runs to its end
-# time; the picture of the last state is kept.
+# time; the picture of the last state is kept. Then the manual's screenshot of
+# lacerta-view (doc/images/lacerta-view.png).
 #
 #   bash contrib/figures/render_paper_figures.sh [build directory, default build]
 #
@@ -60,4 +61,28 @@ render figure-8 square_cut displacement false "Figure 8: the pulled square cut p
 render figure-9 square_hole displacement false "Figure 9: a square punched out" "0, 0.02"
 render figure-10 kidney_cut "cell size" true "Figure 10: cuts on the level of detail"
 render figure-11 square_tear "spring strain" false "Figure 11: a laceration" "-0.2, 1"
-echo "Pictures in $root/doc/images/figure-*.png"
+
+# The manual's screenshot of lacerta-view: a stroke dragged through the pulled slab in
+# real time, the wireframe on, the blade still in the tissue.
+cat > "$work/viewer.prm" <<PRM
+include $root/prm/square_pull.prm
+subsection Viewer
+  set Speed = 1
+  set Field = displacement
+end
+PRM
+cat > "$work/viewer_events.txt" <<EVENTS
+0.3 press 0.25 0.5
+0.5 move 0.35 0.5
+0.7 move 0.45 0.5
+0.9 move 0.55 0.5
+1.1 move 0.62 0.5
+1.3 key w
+1.6 screenshot $root/doc/images/lacerta-view.png
+1.61 release
+1.62 quit
+EVENTS
+echo "lacerta-view screenshot: square_pull"
+(cd "$work" && "$build/lacerta-view" --size 900x600 --events viewer_events.txt \
+  viewer.prm > viewer.log)
+echo "Pictures in $root/doc/images/figure-*.png and lacerta-view.png"

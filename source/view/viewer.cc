@@ -97,9 +97,9 @@ namespace lacerta::view
 
 
     void
-    on_timer(vtkObject *, unsigned long, void *viewer, void *)
+    on_timer(vtkObject *, unsigned long, void *viewer, void *timer_id)
     {
-      static_cast<Viewer *>(viewer)->frame();
+      static_cast<Viewer *>(viewer)->timer(*static_cast<int *>(timer_id));
     }
   } // namespace
 
@@ -161,8 +161,34 @@ namespace lacerta::view
     prm.enter_subsection("Postprocess");
     prm.set("List of postprocessors", "");
     prm.leave_subsection();
-    if (!options.events_file.empty())
+    if (options.benchmark)
+    {
+      if (!options.events_file.empty())
+        throw_error("lacerta-view: --benchmark runs its own stroke; it cannot take "
+                    "--events as well.");
+      // Real time, as a user sees it, drawing as often as the window can.
+      speed             = 1;
+      frames_per_second = 120;
+      std::istringstream script(benchmark_events());
+      parse_events(script, "the benchmark's stroke");
+      // The benchmark's events come on the wall clock, like a hand's: the
+      // simulation never waits for them.
+      next_event_time = 1e300;
+    }
+    else if (!options.events_file.empty())
       read_events();
+  }
+
+
+  std::string
+  Viewer::benchmark_events()
+  {
+    std::ostringstream script;
+    script << "0.5 press 0.3 0.5\n";
+    for (unsigned int k = 1; k <= 50; ++k)
+      script << 0.5 + 0.02 * k << " move " << 0.3 + 0.4 * k / 50 << " 0.5\n";
+    script << "1.5 release\n2 quit\n";
+    return script.str();
   }
 
 
@@ -178,6 +204,13 @@ namespace lacerta::view
     std::ifstream in(options.events_file);
     if (!in)
       throw_error("Events file '", options.events_file, "' cannot be opened.");
+    parse_events(in, "Events file '" + options.events_file + "'");
+  }
+
+
+  void
+  Viewer::parse_events(std::istream &in, const std::string &source)
+  {
     std::string line;
     for (unsigned int number = 1; std::getline(in, line); ++number)
     {
@@ -194,9 +227,8 @@ namespace lacerta::view
         || ((event.what == "release" || event.what == "quit") && n == 0)
         || ((event.what == "key" || event.what == "screenshot") && n == 1);
       if (!good || (!events.empty() && event.time < events.back().time))
-        throw_error("Events file '",
-                    options.events_file,
-                    "', line ",
+        throw_error(source,
+                    ", line ",
                     number,
                     ": expected 'time press|move u v', 'time release', 'time key c', "
                     "'time screenshot file' or 'time quit', in time order.");
@@ -266,6 +298,23 @@ namespace lacerta::view
     {
       if (s.blade != nullptr)
         scalpel->used(s.time, *s.blade);
+      if (bench.measuring)
+      {
+        // Read by print_benchmark() once this thread has ended.
+        if (bench.first_time < 0)
+        {
+          bench.wall_start = Clock::now();
+          bench.first_time = s.time;
+        }
+        else
+          bench.busy_seconds += s.step_seconds;
+        bench.last_time    = s.time;
+        bench.wall_seconds = seconds_since(bench.wall_start);
+        bench.cut_steps += s.cut_tets > 0 ? 1 : 0;
+        bench.cut_tets += s.cut_tets;
+        bench.largest_cut_step = std::max(bench.largest_cut_step, s.cut_step_seconds);
+        bench.tets             = s.mesh->n_tets();
+      }
       // Real time: wait until the wall clock has caught up with the simulation.
       if (*sim_start < 0 || *paced_speed != speed || paused)
       {
@@ -476,6 +525,9 @@ namespace lacerta::view
          ++next_event)
     {
       const Event &e = events[next_event];
+      // --benchmark measures from the press to the release.
+      if (options.benchmark && (e.what == "press" || e.what == "release"))
+        bench.measuring = e.what == "press";
       if (e.what == "press" || e.what == "move")
       {
         // (u, v) in [0, 1] across the window, from its lower left corner.
@@ -501,6 +553,8 @@ namespace lacerta::view
         return;
       }
     }
+    if (options.benchmark)
+      return;
     {
       const std::lock_guard<std::mutex> lock(mutex);
       next_event_time = next_event < events.size() ? events[next_event].time : 1e300;
@@ -521,6 +575,15 @@ namespace lacerta::view
     }
     if (!snapshot || !snapshot->surface)
       return;
+    // Drawing again a state already shown only costs the simulation (software
+    // rendering shares its cores): only new states, and the status once a second.
+    const bool events_due = snapshot->finished || snapshot->time >= next_event_time;
+    if (snapshot == shown && !events_due && seconds_since(shown_at) < 1)
+      return;
+    if (snapshot != shown && bench.measuring)
+      ++bench.frames;
+    shown    = snapshot;
+    shown_at = Clock::now();
     ++n_frames;
     if (seconds_since(fps_since) >= 1)
     {
@@ -544,12 +607,40 @@ namespace lacerta::view
            << (problem.empty() ? "" : "\nStopped: " + problem);
     picture->set_status(status.str());
     window->Render();
-    inject_events(snapshot->finished ? 1e300 : snapshot->time);
+    if (!options.benchmark)
+      inject_events(snapshot->finished ? 1e300 : snapshot->time);
     if (snapshot->finished && !problem.empty() && exit_code == 0)
     {
       exit_code = 1;
       std::cerr << "Error: " << problem << std::endl;
     }
+  }
+
+
+  void
+  Viewer::timer(const int id)
+  {
+    if (id != event_timer)
+    {
+      frame();
+      return;
+    }
+    if (options.benchmark)
+    {
+      // The stroke starts when the first state is on the screen.
+      if (shown && bench.script_start == Clock::time_point())
+        bench.script_start = Clock::now();
+      if (bench.script_start != Clock::time_point())
+        inject_events(seconds_since(bench.script_start));
+      return;
+    }
+    bool events_due = false;
+    {
+      const std::lock_guard<std::mutex> lock(mutex);
+      events_due = latest && (latest->finished || latest->time >= next_event_time);
+    }
+    if (events_due)
+      frame();
   }
 
 
@@ -563,6 +654,7 @@ namespace lacerta::view
 
     vtkNew<vtkRenderWindow> render_window;
     display.attach(*render_window);
+    render_window->SetMultiSamples(0);
     render_window->SetSize(static_cast<int>(options.width),
                            static_cast<int>(options.height));
     render_window->SetWindowName(("lacerta-view " + options.scene_file).c_str());
@@ -581,9 +673,15 @@ namespace lacerta::view
     window_interactor->AddObserver(vtkCommand::TimerEvent, timer);
     window_interactor->CreateRepeatingTimer(
       static_cast<unsigned long>(1000 / frames_per_second));
+    // Scripted events are injected as soon as the simulation reaches them, not at the
+    // next frame, so that a slow picture does not hold the simulation back.
+    if (!events.empty())
+      event_timer = window_interactor->CreateRepeatingTimer(2);
     window_interactor->Start();
 
     stop_simulation();
+    if (options.benchmark)
+      print_benchmark();
     if (!options.record_file.empty())
     {
       scalpel->write_record(options.record_file, options.scene_file);
@@ -598,5 +696,29 @@ namespace lacerta::view
     window     = nullptr;
     interactor = nullptr;
     return exit_code;
+  }
+
+
+  void
+  Viewer::print_benchmark() const
+  {
+    if (bench.wall_seconds <= 0 || bench.busy_seconds <= 0)
+    {
+      std::cout << "Benchmark: the simulation did not reach the end of the stroke.\n";
+      return;
+    }
+    // The first step after the press starts the clocks.
+    const double simulated = bench.last_time - bench.first_time;
+    std::cout << std::setprecision(4)
+              << "Benchmark stroke (1 s of dragging from t = " << bench.first_time
+              << " s): " << simulated << " s simulated in " << bench.wall_seconds
+              << " s: real-time factor " << simulated / bench.wall_seconds << " (aim 1); "
+              << bench.frames << " states drawn: " << bench.frames / bench.wall_seconds
+              << " frames per second (aim " << frames_per_second
+              << "); the simulation's steps took " << bench.busy_seconds
+              << " s: it could run " << simulated / bench.busy_seconds << " x real time; "
+              << bench.cut_steps << " steps cut " << bench.cut_tets
+              << " tetrahedra, the costliest cut step " << 1e3 * bench.largest_cut_step
+              << " ms; " << bench.tets << " tetrahedra at the release\n";
   }
 } // namespace lacerta::view

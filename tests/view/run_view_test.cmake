@@ -5,6 +5,7 @@
 #                    (tetrahedra, cells cut, components);
 #   MODE=png         lacerta runs SCENE with the png postprocessor; its last picture
 #                    must show the tissue;
+#   MODE=benchmark   lacerta-view --benchmark on SCENE must report its figures;
 #   MODE=no_display  PROGRAM on SCENE without DISPLAY must stop with exit code 1 and a
 #                    message that names xvfb-run.
 # Variables: MODE, SCENE, EVENTS, VIEWER, LACERTA, PROGRAM, COVERAGE (the script),
@@ -51,6 +52,15 @@ if(MODE STREQUAL "viewer")
      OR NOT view_pieces EQUAL replay_pieces)
     message(FATAL_ERROR "the recorded stroke does not replay to the same mesh")
   endif()
+elseif(MODE STREQUAL "benchmark")
+  # The figures depend on the machine; the run must reach the end of its stroke and
+  # report them.
+  run_checked(${XVFB} ${VIEWER} --size 800x600 --benchmark ${SCENE})
+  string(REGEX MATCH "Benchmark stroke[^\n]*real-time factor ([0-9.e+-]+)[^\n]* ([0-9.e+-]+) frames per second" m "${out}")
+  if(NOT m)
+    message(FATAL_ERROR "no benchmark figures in:\n${out}")
+  endif()
+  message(STATUS "${m}")
 elseif(MODE STREQUAL "png")
   run_checked(${XVFB} ${LACERTA} ${SCENE})
   file(GLOB pictures ${WORK}/output/png/picture-*.png)

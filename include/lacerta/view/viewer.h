@@ -53,7 +53,18 @@ namespace lacerta::view
       std::string events_file;
       /// Window size [pixels].
       unsigned int width = 1024, height = 768;
+      /// Run the benchmark stroke (benchmark_events()) in real time at 60 frames per
+      /// second and print the frame rate and real-time factor through it.
+      bool benchmark = false;
     };
+
+    /**
+     * The scripted stroke of `--benchmark`, in wall-clock seconds from the first state
+     * drawn: a press left of the window's middle at 0.5 s, a drag across 40 % of the
+     * window for 1 s (one move every 20 ms), a release, and quit 0.5 s later.
+     */
+    static std::string
+    benchmark_events();
 
     /// Declares `subsection Viewer`.
     static void
@@ -83,8 +94,12 @@ namespace lacerta::view
     /// viewer's.
     bool
     key(char key);
-    /// Viewer thread: the frame timer fired (new surface, status line, scripted
-    /// events).
+    /// Viewer thread: the timer @p id fired: the frame timer draws a frame, the
+    /// events' timer draws one only if scripted events are due.
+    void
+    timer(int id);
+    /// Viewer thread: draws the newest state if it is new (or a second has passed),
+    /// with the status line, and injects the scripted events it has reached.
     void
     frame();
 
@@ -122,6 +137,30 @@ namespace lacerta::view
     /// Injects the scripted events whose time has come.
     void
     inject_events(double simulated_time);
+    /// Parses scripted events from @p in, read from @p source (for messages).
+    void
+    parse_events(std::istream &in, const std::string &source);
+    /// Prints the figures of `--benchmark`.
+    void
+    print_benchmark() const;
+
+    /**
+     * What `--benchmark` measures between the stroke's press and its release: the
+     * simulated and wall-clock span, the distinct states drawn, the simulation's own
+     * time (its steps, without waiting or drawing) and the cut.
+     */
+    struct BenchmarkFigures
+    {
+      /// Between the press and the release (set by the viewer's thread).
+      std::atomic<bool> measuring{false};
+      /// When the script's clock started (the first state drawn).
+      std::chrono::steady_clock::time_point script_start{};
+      /// Simulated time of the first and of the last step measured.
+      double       first_time = -1, last_time = 0;
+      double       wall_seconds = 0, busy_seconds = 0, largest_cut_step = 0;
+      unsigned int frames = 0, cut_steps = 0, cut_tets = 0, tets = 0;
+      std::chrono::steady_clock::time_point wall_start;
+    };
 
     Options                       options;
     dealii::ParameterHandler      prm;
@@ -153,5 +192,11 @@ namespace lacerta::view
     vtkRenderWindow           *window     = nullptr;
     vtkRenderWindowInteractor *interactor = nullptr;
     int                        exit_code  = 0;
+    /// The timer of the scripted events (-1: none).
+    int              event_timer = -1;
+    BenchmarkFigures bench;
+    /// The state drawn last, and when.
+    std::shared_ptr<Snapshot>             shown;
+    std::chrono::steady_clock::time_point shown_at;
   };
 } // namespace lacerta::view
