@@ -3,7 +3,8 @@
 # (doc/viewer.md) into doc/images/figure-*.png: the square pulled and cut, the punched
 # hole, the kidney's cuts on the level of detail, the tear. Each scene runs to its end
 # time; the picture of the last state is kept. Then the manual's screenshot of
-# lacerta-view (doc/images/lacerta-view.png).
+# lacerta-view (doc/images/lacerta-view.png) and doc/accuracy.md's springs against FEM
+# (doc/images/square_pull_comparison.png; needs python3-vtk9).
 #
 #   bash contrib/figures/render_paper_figures.sh [build directory, default build]
 #
@@ -72,11 +73,11 @@ subsection Viewer
 end
 PRM
 cat > "$work/viewer_events.txt" <<EVENTS
-0.3 press 0.25 0.5
-0.5 move 0.35 0.5
-0.7 move 0.45 0.5
-0.9 move 0.55 0.5
-1.1 move 0.62 0.5
+0.3 press 0.3 0.5
+0.5 move 0.4 0.5
+0.7 move 0.5 0.5
+0.9 move 0.6 0.5
+1.1 move 0.68 0.5
 1.3 key w
 1.6 screenshot $root/doc/images/lacerta-view.png
 1.61 release
@@ -85,4 +86,25 @@ EVENTS
 echo "lacerta-view screenshot: square_pull"
 (cd "$work" && "$build/lacerta-view" --size 900x600 --events viewer_events.txt \
   viewer.prm > viewer.log)
-echo "Pictures in $root/doc/images/figure-*.png and lacerta-view.png"
+
+# doc/accuracy.md's springs against FEM on prm/square_pull_comparison.prm, side by side
+# on one colour scale: the `fem comparison` postprocessor writes its fields at t = 0.5 s,
+# the end of the pull, and render_comparison.py (python3-vtk9) draws them.
+cat > "$work/comparison.prm" <<PRM
+include $root/prm/square_pull_comparison.prm
+set Output directory = $work/output
+set End time         = 0.5
+subsection Postprocess
+  subsection Fem comparison
+    set Time between fields   = 0.5
+    set Number of frequencies = 0
+  end
+end
+PRM
+echo "springs against FEM: square_pull_comparison"
+"$build/lacerta" "$work/comparison.prm" > "$work/comparison.log"
+grep "Comparison at t = 0.5 s" "$work/comparison.log"
+/usr/bin/python3 "$root/contrib/figures/render_comparison.py" \
+  "$work/output/comparison-00001.vtu" "$root/doc/images/square_pull_comparison.png" \
+  "square_pull_comparison at t = 0.5 s: springs and FEM P2 on the same 60 tetrahedra"
+echo "Pictures in $root/doc/images/: figure-*.png, lacerta-view.png, square_pull_comparison.png"

@@ -17,6 +17,8 @@ $SUDO apt-get update
 #  libeigen3-dev     small dense algebra, eigenvalue checks in tests
 #  libgtest-dev, libbenchmark-dev   unit tests and benchmarks
 #  python3-matplotlib  study plots (error against run time)
+#  python3-vtk9      the spring-against-FEM render of doc/accuracy.md
+#                    (contrib/figures/render_paper_figures.sh)
 #  clang-14, libclang-rt-14-dev   the sanitizer and fuzzing build (libFuzzer)
 #  xvfb, xauth       a virtual X display: Debian's VTK renders (lacerta-view, the png
 #                    postprocessor) only with an X server, and the tests run under
@@ -27,6 +29,6 @@ $SUDO apt-get install -y --no-install-recommends \
   numdiff perl openmpi-bin libopenmpi-dev \
   libvtk9-dev libcgal-dev libeigen3-dev \
   libgtest-dev libbenchmark-dev \
-  clang-format python3 python3-matplotlib \
+  clang-format python3 python3-matplotlib python3-vtk9 \
   clang-14 libclang-rt-14-dev \
   xvfb xauth

@@ -8,12 +8,15 @@
 #include <lacerta/fem/scene_problem.h>
 #include <lacerta/fem/spring_statics.h>
 #include <lacerta/physics/particle_system.h>
+#include <lacerta/postprocess/output_schedule.h>
 #include <lacerta/postprocess/postprocessor.h>
+#include <lacerta/postprocess/vtu_file.h>
 #include <lacerta/scene/material.h>
 
 #include <deal.II/base/utilities.h>
 
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <sstream>
 
@@ -44,6 +47,13 @@ namespace lacerta::fem
                           dealii::Patterns::Integer(0, 50),
                           "How many of the lowest vibration frequencies of the springs "
                           "and of FEM to compute and print at the start.");
+        prm.declare_entry("Time between fields",
+                          "0",
+                          dealii::Patterns::Double(0, 1e6),
+                          "Simulated time [s] between two files comparison-NNNNN.vtu "
+                          "(the mesh at rest with the displacement of the springs and "
+                          "of FEM at every vertex, and their difference); 0 writes "
+                          "none.");
         prm.declare_entry("Time between prints",
                           "0.05",
                           dealii::Patterns::Double(0, 1e6),
@@ -68,13 +78,16 @@ namespace lacerta::fem
                             dealii::Utilities::string_to_double(values[2])});
         }
         n_frequencies  = prm.get_integer("Number of frequencies");
+        field_interval = prm.get_double("Time between fields");
+        fields.set_interval(field_interval);
         print_interval = prm.get_double("Time between prints");
       }
 
       void
       initialize(const std::string &output_directory, bool) override
       {
-        table = OutputFile(output_directory + "/comparison.csv");
+        directory = output_directory;
+        table     = OutputFile(output_directory + "/comparison.csv");
       }
 
       void
@@ -110,6 +123,11 @@ namespace lacerta::fem
             row << ',' << springs[3 * v + d] << ',' << fem.vertex[3 * v + d];
         row << '\n';
         table.append(row.str());
+        if (field_interval > 0 && fields.due(state.time))
+        {
+          write_fields(state, springs, fem.vertex);
+          fields.written(state.time);
+        }
         if (state.time >= next_print - 1e-9 * state.time_step)
         {
           next_print += print_interval;
@@ -121,6 +139,27 @@ namespace lacerta::fem
       }
 
     private:
+      /// Writes comparison-NNNNN.vtu: the mesh at rest, the displacements @p springs
+      /// and @p fem (3 per vertex) and springs - fem.
+      void
+      write_fields(const postprocess::RunState &state,
+                   const std::vector<double>   &springs,
+                   const std::vector<double>   &fem)
+      {
+        std::vector<double> difference(springs.size());
+        for (std::size_t k = 0; k < springs.size(); ++k)
+          difference[k] = springs[k] - fem[k];
+        char name[64];
+        std::snprintf(name, sizeof(name), "/comparison-%05u.vtu", n_fields++);
+        postprocess::write_vtu_file(directory + name,
+                                    *state.mesh,
+                                    state.system->rest_position(),
+                                    {{"springs_displacement", 3, &springs},
+                                     {"fem_displacement", 3, &fem},
+                                     {"springs_minus_fem", 3, &difference}},
+                                    {});
+      }
+
       void
       start(const postprocess::RunState &state)
       {
@@ -173,6 +212,10 @@ namespace lacerta::fem
       std::vector<unsigned int>         probe_vertices;
       unsigned int                      n_frequencies  = 0;
       double                            print_interval = 0.05, next_print = 0;
+      double                            field_interval = 0;
+      postprocess::OutputSchedule       fields;
+      unsigned int                      n_fields = 0;
+      std::string                       directory;
       Problem                           problem;
       std::unique_ptr<ElasticitySolver> solver;
       NodalError                        total;

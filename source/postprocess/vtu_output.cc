@@ -7,17 +7,8 @@
 #include <lacerta/physics/spring_strain.h>
 #include <lacerta/postprocess/output_schedule.h>
 #include <lacerta/postprocess/postprocessor.h>
+#include <lacerta/postprocess/vtu_file.h>
 #include <lacerta/scene/material.h>
-
-#include <vtkCellArray.h>
-#include <vtkCellData.h>
-#include <vtkCellType.h>
-#include <vtkDoubleArray.h>
-#include <vtkNew.h>
-#include <vtkPointData.h>
-#include <vtkPoints.h>
-#include <vtkUnstructuredGrid.h>
-#include <vtkXMLUnstructuredGridWriter.h>
 
 #include <cmath>
 #include <cstdio>
@@ -27,17 +18,6 @@ namespace lacerta::postprocess
 {
   namespace
   {
-    vtkSmartPointer<vtkDoubleArray>
-    make_array(const char *name, const int components, const vtkIdType tuples)
-    {
-      auto array = vtkSmartPointer<vtkDoubleArray>::New();
-      array->SetName(name);
-      array->SetNumberOfComponents(components);
-      array->SetNumberOfTuples(tuples);
-      return array;
-    }
-
-
     /**
      * Writes the deformed mesh as solution-NNNNN.vtu (compressed binary) and the series
      * solution.pvd. Point data: displacement, velocity, mass, fixed; cell data: the
@@ -93,22 +73,13 @@ namespace lacerta::postprocess
         const physics::ParticleSystem &system = *s.system;
         const unsigned int             n      = system.n_particles();
 
-        vtkNew<vtkPoints> points;
-        points->SetDataTypeToDouble();
-        points->SetNumberOfPoints(n);
-        auto displacement = make_array("displacement", 3, n);
-        auto velocity     = make_array("velocity", 3, n);
-        auto mass         = make_array("mass", 1, n);
-        auto fixed        = make_array("fixed", 1, n);
+        std::vector<double> displacement(3 * n), fixed(n);
         for (unsigned int i = 0; i < n; ++i)
         {
-          const double *x = &system.position[3 * i];
-          points->SetPoint(i, x);
           for (unsigned int d = 0; d < 3; ++d)
-            displacement->SetComponent(i, d, x[d] - system.rest_position()[3 * i + d]);
-          velocity->SetTuple(i, &system.velocity[3 * i]);
-          mass->SetValue(i, system.mass[i]);
-          fixed->SetValue(i, 1.0 - system.free[i]);
+            displacement[3 * i + d] =
+              system.position[3 * i + d] - system.rest_position()[3 * i + d];
+          fixed[i] = 1.0 - system.free[i];
         }
 
         // Springs are the mesh's edges, in the same order.
@@ -116,52 +87,37 @@ namespace lacerta::postprocess
         for (std::size_t e = 0; e < strain.size(); ++e)
           strain[e] = physics::spring_strain(system, static_cast<unsigned int>(e));
 
-        vtkNew<vtkCellArray> cells;
-        auto                 cell_strain  = make_array("spring_strain", 1, mesh.n_tets());
-        auto                 cell_density = make_array("density", 1, mesh.n_tets());
-        auto cell_modulus = make_array("youngs_modulus", 1, mesh.n_tets());
+        std::vector<double> cell_strain(mesh.n_tets()), cell_density(mesh.n_tets()),
+          cell_modulus(mesh.n_tets());
         for (unsigned int t = 0; t < mesh.n_tets(); ++t)
         {
-          const vtkIdType ids[4] = {mesh.tet(t)[0],
-                                    mesh.tet(t)[1],
-                                    mesh.tet(t)[2],
-                                    mesh.tet(t)[3]};
-          cells->InsertNextCell(4, ids);
           double largest = 0;
           for (const unsigned int e : mesh.tet_edges(t))
             if (std::abs(strain[e]) > std::abs(largest))
               largest = strain[e];
-          cell_strain->SetValue(t, largest);
+          cell_strain[t] = largest;
           dealii::Point<3> centroid;
           for (const unsigned int v : mesh.tet(t))
             for (unsigned int d = 0; d < 3; ++d)
               centroid[d] += 0.25 * mesh.vertex(v)[d];
-          cell_density->SetValue(t, s.material->density().value(centroid));
-          cell_modulus->SetValue(t, s.material->youngs_modulus().value(centroid));
+          cell_density[t] = s.material->density().value(centroid);
+          cell_modulus[t] = s.material->youngs_modulus().value(centroid);
         }
 
-        vtkNew<vtkUnstructuredGrid> grid;
-        grid->SetPoints(points);
-        grid->SetCells(VTK_TETRA, cells);
-        for (auto *array : {displacement.Get(), velocity.Get(), mass.Get(), fixed.Get()})
-          grid->GetPointData()->AddArray(array);
-        for (auto *array : {cell_strain.Get(), cell_density.Get(), cell_modulus.Get()})
-          grid->GetCellData()->AddArray(array);
-
-        // The file is composed in memory and then replaced atomically, like the
-        // series after it: a write that fails leaves every earlier file and the series
-        // that lists them valid.
+        // Each file, then the series that lists it, is replaced atomically: a write
+        // that fails leaves every earlier file and the series valid.
         char name[64];
         std::snprintf(name, sizeof(name), "solution-%05u.vtu", n_written);
-        vtkNew<vtkXMLUnstructuredGridWriter> writer;
-        writer->WriteToOutputStringOn();
-        writer->SetInputData(grid);
-        writer->SetDataModeToAppended();
-        writer->SetCompressorTypeToZLib();
-        if (writer->Write() != 1)
-          throw_error(
-            "Cannot write '", directory, "/", name, "': VTK failed to encode it.");
-        write_file_atomically(directory + "/" + name, writer->GetOutputString());
+        write_vtu_file(directory + "/" + name,
+                       mesh,
+                       system.position,
+                       {{"displacement", 3, &displacement},
+                        {"velocity", 3, &system.velocity},
+                        {"mass", 1, &system.mass},
+                        {"fixed", 1, &fixed}},
+                       {{"spring_strain", 1, &cell_strain},
+                        {"density", 1, &cell_density},
+                        {"youngs_modulus", 1, &cell_modulus}});
         ++n_written;
 
         series.emplace_back(s.time, name);
