@@ -216,7 +216,7 @@ namespace lacerta::bench
             << "  set Enabled = true\n"
             << "  set Cache directory = " << std::filesystem::current_path().string()
             << "/mt-cache\n"
-            << "  set Focus path = 0; 0.05*sin(10*t); 0.02\n"
+            << "  set Focus follows = tool\n"
             << "  set Re-extraction distance = 0.005\n"
             << "  set Query = focus\n"
             << "  subsection Focus\n    set Radius = 0.02\n"
