@@ -8,6 +8,7 @@
 #include <deal.II/base/function_parser.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <ostream>
 
@@ -173,11 +174,13 @@ namespace lacerta::mt
     if (enter <= leave)
       return mesh::lerp(blade.tail, blade.head, 0.5 * (enter + leave));
     // Outside: the point of the box nearest to the blade. The distance to the box is
-    // convex along the segment, so a golden-section search finds the blade's point
-    // nearest to the box, which is then moved onto the box.
-    const auto distance_to_box = [this](const mesh::Point3 &x)
+    // convex along the segment, but flat where the blade runs parallel to a face: the
+    // blade's nearest points then form an interval, and its middle is taken. Samples
+    // bracket the interval, a golden-section search refines a single minimum.
+    const auto distance_to_box = [&](const double s)
     {
-      double squared = 0;
+      const mesh::Point3 x       = mesh::lerp(blade.tail, blade.head, s);
+      double             squared = 0;
       for (unsigned int d = 0; d < 3; ++d)
       {
         const double out = std::max({box_low[d] - x[d], 0.0, x[d] - box_high[d]});
@@ -185,22 +188,34 @@ namespace lacerta::mt
       }
       return squared;
     };
-    const double ratio = 0.5 * (std::sqrt(5.0) - 1);
-    double       low = 0, high = 1;
-    for (unsigned int i = 0; i < 80; ++i)
+    constexpr unsigned int    n = 64;
+    std::array<double, n + 1> sampled;
+    for (unsigned int k = 0; k <= n; ++k)
+      sampled[k] = distance_to_box(double(k) / n);
+    const double least = *std::min_element(sampled.begin(), sampled.end());
+    const double tie   = 1e-12 * (least + mesh::dot(along, along));
+    unsigned int first = 0, last = n;
+    while (sampled[first] > least + tie)
+      ++first;
+    while (sampled[last] > least + tie)
+      --last;
+    double best = 0.5 * (first + last) / n;
+    if (first == last)
     {
-      const double s1 = high - ratio * (high - low), s2 = low + ratio * (high - low);
-      if (distance_to_box(mesh::lerp(blade.tail, blade.head, s1))
-          <= distance_to_box(mesh::lerp(blade.tail, blade.head, s2)))
-        high = s2;
-      else
-        low = s1;
+      const double ratio = 0.5 * (std::sqrt(5.0) - 1);
+      double       low   = std::max(0.0, (first - 1.0) / n),
+             high        = std::min(1.0, (first + 1.0) / n);
+      for (unsigned int i = 0; i < 60; ++i)
+      {
+        const double s1 = high - ratio * (high - low), s2 = low + ratio * (high - low);
+        if (distance_to_box(s1) <= distance_to_box(s2))
+          high = s2;
+        else
+          low = s1;
+      }
+      if (distance_to_box(0.5 * (low + high)) < sampled[first])
+        best = 0.5 * (low + high);
     }
-    double best = 0.5 * (low + high);
-    for (const double end : {0.0, 1.0})
-      if (distance_to_box(mesh::lerp(blade.tail, blade.head, end))
-          <= distance_to_box(mesh::lerp(blade.tail, blade.head, best)))
-        best = end;
     mesh::Point3 nearest = mesh::lerp(blade.tail, blade.head, best);
     for (unsigned int d = 0; d < 3; ++d)
       nearest[d] = std::clamp(nearest[d], box_low[d], box_high[d]);

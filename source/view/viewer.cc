@@ -680,8 +680,8 @@ namespace lacerta::view
     window_interactor->Start();
 
     stop_simulation();
-    if (options.benchmark)
-      print_benchmark();
+    if (options.benchmark && !print_benchmark() && exit_code == 0)
+      exit_code = 1;
     if (!options.record_file.empty())
     {
       scalpel->write_record(options.record_file, options.scene_file);
@@ -699,13 +699,14 @@ namespace lacerta::view
   }
 
 
-  void
+  bool
   Viewer::print_benchmark() const
   {
     if (bench.wall_seconds <= 0 || bench.busy_seconds <= 0)
     {
-      std::cout << "Benchmark: the simulation did not reach the end of the stroke.\n";
-      return;
+      std::cerr << "Error: lacerta-view --benchmark: the simulation made fewer than two "
+                   "steps during the stroke; nothing was measured.\n";
+      return false;
     }
     // The first step after the press starts the clocks.
     const double simulated = bench.last_time - bench.first_time;
@@ -720,5 +721,6 @@ namespace lacerta::view
               << bench.cut_steps << " steps cut " << bench.cut_tets
               << " tetrahedra, the costliest cut step " << 1e3 * bench.largest_cut_step
               << " ms; " << bench.tets << " tetrahedra at the release\n";
+    return true;
   }
 } // namespace lacerta::view

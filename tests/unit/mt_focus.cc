@@ -109,6 +109,16 @@ namespace lacerta
     EXPECT_NEAR(beside[0], 0.05, 1e-12);
     EXPECT_NEAR(beside[1], 0.01, 1e-9);
     EXPECT_NEAR(beside[2], 0.01, 1e-9);
+    // Flat above the top face: the middle of the blade's nearest points, on the face.
+    const mesh::Point3 flat = focus({{-0.02, 0.01, 0.03}}, {{0.04, 0.01, 0.03}});
+    EXPECT_NEAR(flat[0], 0.01, 1e-3);
+    EXPECT_NEAR(flat[1], 0.01, 1e-12);
+    EXPECT_NEAR(flat[2], 0.02, 1e-12);
+    // Flat, half beyond the slab's edge x = 0.05: the middle of the part above it (to
+    // the sampling's 1/64 of the blade).
+    const mesh::Point3 half = focus({{0.03, 0, 0.03}}, {{0.09, 0, 0.03}});
+    EXPECT_NEAR(half[0], 0.04, 1e-3);
+    EXPECT_NEAR(half[2], 0.02, 1e-12);
     // A point blade inside.
     const mesh::Point3 point = focus({{0, 0, 0.01}}, {{0, 0, 0.01}});
     EXPECT_NEAR(point[2], 0.01, 1e-12);

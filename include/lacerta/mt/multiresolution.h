@@ -161,8 +161,10 @@ namespace lacerta::mt
     /**
      * Where a blade puts the focus: the middle of the part of the segment inside the
      * bounding box of the mesh at rest, or, if it misses the box, the point of the box
-     * nearest to it. The blade's world coordinates are taken as rest coordinates, which the
-     * level of detail's fine region (a few cells around the focus) tolerates.
+     * nearest to it (where the blade runs parallel to a face, nearest to the middle of
+     * the blade's nearest points, to 1/64 of the blade). The blade's world coordinates
+     * are taken as rest coordinates, which the level of detail's fine region (a few cells
+     * around the focus) tolerates.
      */
     mesh::Point3
     focus_of_blade(const cut::Blade &blade) const;

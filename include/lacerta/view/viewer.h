@@ -140,8 +140,9 @@ namespace lacerta::view
     /// Parses scripted events from @p in, read from @p source (for messages).
     void
     parse_events(std::istream &in, const std::string &source);
-    /// Prints the figures of `--benchmark`.
-    void
+    /// Prints the figures of `--benchmark`; false (and a message) if the simulation
+    /// made too few steps during the stroke to measure.
+    bool
     print_benchmark() const;
 
     /**
