@@ -104,36 +104,87 @@ namespace lacerta::physics
   }
 
 
+  namespace
+  {
+    /// The squares of particle_frequency_bounds() from the system's Gershgorin
+    /// @p terms.
+    std::vector<double>
+    squared_frequencies(const ParticleSystem &system, const GershgorinTerms &terms)
+    {
+      const unsigned int  n = system.n_particles();
+      std::vector<double> off_diagonal(n, 0.0);
+      for (std::size_t s = 0; s < system.springs.size(); ++s)
+        if (terms.coupling[s] > 0)
+        {
+          const unsigned int i = system.springs.a[s], j = system.springs.b[s];
+          const double c = terms.coupling[s] / std::sqrt(system.mass[i] * system.mass[j]);
+          off_diagonal[i] += c;
+          off_diagonal[j] += c;
+        }
+      std::vector<double> lambda(n, 0.0);
+      for (unsigned int i = 0; i < n; ++i)
+        if (system.free[i] > 0 && system.mass[i] > 0)
+          lambda[i] = terms.diagonal[i] / system.mass[i] + off_diagonal[i];
+      return lambda;
+    }
+  } // namespace
+
+
+  std::vector<double>
+  particle_frequency_bounds(const ParticleSystem &system)
+  {
+    std::vector<double> omega =
+      squared_frequencies(system, gershgorin_terms(system, system.position.data()));
+    for (double &w : omega)
+      w = std::sqrt(w);
+    return omega;
+  }
+
+
   FrequencyBound
   bound_highest_frequency(const ParticleSystem &system)
   {
-    const unsigned int    n     = system.n_particles();
-    const GershgorinTerms terms = gershgorin_terms(system, system.position.data());
-    std::vector<double>   off_diagonal(n, 0.0);
-    for (std::size_t s = 0; s < system.springs.size(); ++s)
-      if (terms.coupling[s] > 0)
+    const GershgorinTerms     terms  = gershgorin_terms(system, system.position.data());
+    const std::vector<double> lambda = squared_frequencies(system, terms);
+    FrequencyBound            bound;
+    double                    largest = 0;
+    for (unsigned int i = 0; i < lambda.size(); ++i)
+      if (lambda[i] > largest)
       {
-        const unsigned int i = system.springs.a[s], j = system.springs.b[s];
-        const double c = terms.coupling[s] / std::sqrt(system.mass[i] * system.mass[j]);
-        off_diagonal[i] += c;
-        off_diagonal[j] += c;
-      }
-
-    FrequencyBound bound;
-    double         largest = 0;
-    for (unsigned int i = 0; i < n; ++i)
-      if (system.free[i] > 0 && system.mass[i] > 0)
-      {
-        const double lambda = terms.diagonal[i] / system.mass[i] + off_diagonal[i];
-        if (lambda > largest)
-        {
-          largest        = lambda;
-          bound.particle = i;
-          bound.spring   = terms.stiffest_spring[i];
-        }
+        largest        = lambda[i];
+        bound.particle = i;
+        bound.spring   = terms.stiffest_spring[i];
       }
     bound.omega = std::sqrt(largest);
     return bound;
+  }
+
+
+  double
+  multirate_evaluation_share(const ParticleSystem &system)
+  {
+    const std::vector<double> omega   = particle_frequency_bounds(system);
+    const double              highest = *std::max_element(omega.begin(), omega.end());
+    if (system.springs.size() == 0 || !(highest > 0))
+      return 1;
+    double evaluations = 0;
+    for (std::size_t s = 0; s < system.springs.size(); ++s)
+    {
+      const double fastest =
+        std::max(omega[system.springs.a[s]], omega[system.springs.b[s]]);
+      // A spring steps at the single-rate step times the largest power of two that
+      // keeps ω h below the bound at both its particles (ω h scales as 1/ω).
+      double step = 1;
+      // Ties (a regular mesh's boundary has particles at exactly half the frequency)
+      // count as allowed whatever the rounding, so the share is the same on every
+      // compiler.
+      while (fastest > 0 && 2 * step * fastest <= highest * (1 + 1e-9) && step < 1024)
+        step *= 2;
+      if (fastest == 0)
+        step = 1024;
+      evaluations += 1 / step;
+    }
+    return evaluations / system.springs.size();
   }
 
 

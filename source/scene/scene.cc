@@ -8,6 +8,7 @@
 #include <lacerta/physics/assembly.h>
 #include <lacerta/physics/force_model.h>
 #include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/stability.h>
 #include <lacerta/scene/region.h>
 #include <lacerta/scene/scene.h>
 
@@ -66,6 +67,14 @@ namespace lacerta::scene
                                                               blade ? &*blade : nullptr);
     }
     system = std::make_unique<physics::ParticleSystem>(std::vector<double>());
+    if (multiresolution)
+    {
+      // The full mesh's stability, to set the level of detail's against (issue 17):
+      // assembled once, then replaced by the level of detail.
+      assemble(mesh, 0.0);
+      full_mesh_stability.omega = physics::bound_highest_frequency(*system).omega;
+      full_mesh_stability.multirate_share = physics::multirate_evaluation_share(*system);
+    }
     assemble(active_mesh(), 0.0);
     system->set_force_model(physics::ForceModel::create(prm), n_threads);
     initial_volume    = mesh.total_volume();

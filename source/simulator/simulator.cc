@@ -24,6 +24,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <numeric>
 #include <sstream>
@@ -371,6 +372,30 @@ namespace lacerta
 
 
   void
+  Simulator::print_stability_against_full_mesh() const
+  {
+    const physics::ParticleSystem &system   = *scene->system;
+    const auto                     critical = [&](const double omega)
+    {
+      return integrator->critical_time_step(omega,
+                                            system.mass_damping,
+                                            system.spring_damping);
+    };
+    const double lod_omega = physics::bound_highest_frequency(system).omega;
+    const scene::Scene::StabilityAtRest &full = scene->full_mesh_stability;
+    std::cout << "Stability against the full mesh: critical time step "
+              << critical(lod_omega) << " s on the level of detail, "
+              << critical(full.omega)
+              << " s on the full mesh; multi-rate stepping (each spring at its own "
+                 "stable step, in powers of two) would evaluate "
+              << std::setprecision(3) << 100 * physics::multirate_evaluation_share(system)
+              << " % of the level of detail's springs per step (full mesh: "
+              << 100 * full.multirate_share << " %)\n"
+              << std::setprecision(6);
+  }
+
+
+  void
   Simulator::run()
   {
     dealii::TimerOutput      timer(std::cout,
@@ -383,6 +408,8 @@ namespace lacerta
     std::cout << "Integrator: "
               << "time step " << time_step << " s, end time " << end_time << " s\n";
     unsigned int substeps = choose_substeps();
+    if (scene->multiresolution)
+      print_stability_against_full_mesh();
 
     physics::BlowUpMonitor monitor(system, energy_tolerance);
     const auto             check = [&](const unsigned int step)

@@ -373,3 +373,31 @@ TEST(Stability, ParallelForcesEqualSerialForces)
   for (std::size_t i = 0; i < a1.size(); ++i)
     EXPECT_NEAR(a1[i], a2[i], 1e-12 * scale);
 }
+
+
+TEST(Stability, MultirateShareCountsEachSpringAtItsOwnStep)
+{
+  // Three separate springs of one stiffness whose particles weigh 1, 4 and 16 times as
+  // much: their frequencies are ω, ω/2 and ω/4, so multi-rate stepping evaluates them
+  // every step, every second and every fourth step.
+  std::vector<double> rest;
+  for (unsigned int i = 0; i < 6; ++i)
+    for (const double x : {0.1 * i, 0.0, 0.0})
+      rest.push_back(x);
+  physics::ParticleSystem system(rest);
+  system.mass = {1, 1, 4, 4, 16, 16};
+  for (unsigned int s = 0; s < 3; ++s)
+    system.springs.push_back(2 * s, 2 * s + 1, 100, 0.1);
+  system.enforce_constraints = [](double, double *, double *) {};
+  system.set_force_model(physics::ForceModelRegistry::create("linear springs"), 1);
+
+  const std::vector<double> omega = physics::particle_frequency_bounds(system);
+  EXPECT_NEAR(omega[2], omega[0] / 2, 1e-12 * omega[0]);
+  EXPECT_NEAR(omega[4], omega[0] / 4, 1e-12 * omega[0]);
+  EXPECT_DOUBLE_EQ(physics::bound_highest_frequency(system).omega, omega[0]);
+  EXPECT_NEAR(physics::multirate_evaluation_share(system), (1 + 0.5 + 0.25) / 3, 1e-12);
+
+  // Equal particles: nothing to save.
+  system.mass = {1, 1, 1, 1, 1, 1};
+  EXPECT_DOUBLE_EQ(physics::multirate_evaluation_share(system), 1.0);
+}

@@ -60,6 +60,23 @@ namespace lacerta::physics
   bound_highest_frequency(const ParticleSystem &system);
 
   /**
+   * The block Gershgorin bound of bound_highest_frequency() at every particle (rad/s;
+   * 0 for constrained or massless ones): the highest frequency of the springs around it.
+   */
+  std::vector<double>
+  particle_frequency_bounds(const ParticleSystem &system);
+
+  /**
+   * What multi-rate integration could save: the share of the spring evaluations of a
+   * single-rate step (all springs at the step of the highest frequency) that remain if
+   * every spring stepped at its own stable step, the single-rate step times the largest
+   * power of two (up to 1024) that the frequency bounds at its two particles allow.
+   * 1 means no saving; 0.25 means a quarter of the evaluations.
+   */
+  double
+  multirate_evaluation_share(const ParticleSystem &system);
+
+  /**
    * Describes spring @p s of @p system for messages: its particles, rest positions,
    * stiffness and length.
    */

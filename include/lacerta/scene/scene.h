@@ -144,6 +144,17 @@ namespace lacerta::scene
     double integral_of_density = 0;
     /// The multiresolution model, only if the scene enables it.
     std::unique_ptr<mt::Multiresolution> multiresolution;
+
+    /// The stability of a system at rest (physics/stability.h).
+    struct StabilityAtRest
+    {
+      /// Bound on the highest angular eigenfrequency (rad/s).
+      double omega = 0;
+      /// physics::multirate_evaluation_share().
+      double multirate_share = 1;
+    };
+    /// With multiresolution: the full mesh's, assembled at rest once at the start.
+    StabilityAtRest full_mesh_stability;
     /// Volume of the mesh as built (cuts conserve it).
     double initial_volume = 0;
     /// The cutting tool and the cutter, only if `Tool/Type` is not `none`.

@@ -108,6 +108,14 @@ namespace lacerta
     unsigned int
     choose_substeps(unsigned int current = 0);
 
+    /**
+     * With multiresolution: prints the critical time step of the level of detail next
+     * to the full mesh's, and the share of spring evaluations multi-rate stepping would
+     * leave on each (issue 17).
+     */
+    void
+    print_stability_against_full_mesh() const;
+
     std::string  output_directory;
     double       end_time;
     double       time_step;
