@@ -117,14 +117,8 @@ namespace lacerta::mt
     prm.leave_subsection();
     boundary_error = parameters.maximum_boundary_error;
 
-    box_low  = {{1e300, 1e300, 1e300}};
-    box_high = {{-1e300, -1e300, -1e300}};
     for (const mesh::Point3 &x : input.get_vertices())
-      for (unsigned int d = 0; d < 3; ++d)
-      {
-        box_low[d]  = std::min(box_low[d], x[d]);
-        box_high[d] = std::max(box_high[d], x[d]);
-      }
+      box.extend(x);
 
     mt         = load_or_build(input, parameters, locked, directory, cache);
     lod        = std::make_unique<Lod>(mt);
@@ -160,12 +154,12 @@ namespace lacerta::mt
     {
       if (along[d] == 0)
       {
-        if (blade.tail[d] < box_low[d] || blade.tail[d] > box_high[d])
+        if (blade.tail[d] < box.lower[d] || blade.tail[d] > box.upper[d])
           leave = -1;
         continue;
       }
-      double a = (box_low[d] - blade.tail[d]) / along[d];
-      double b = (box_high[d] - blade.tail[d]) / along[d];
+      double a = (box.lower[d] - blade.tail[d]) / along[d];
+      double b = (box.upper[d] - blade.tail[d]) / along[d];
       if (a > b)
         std::swap(a, b);
       enter = std::max(enter, a);
@@ -183,7 +177,7 @@ namespace lacerta::mt
       double             squared = 0;
       for (unsigned int d = 0; d < 3; ++d)
       {
-        const double out = std::max({box_low[d] - x[d], 0.0, x[d] - box_high[d]});
+        const double out = std::max({box.lower[d] - x[d], 0.0, x[d] - box.upper[d]});
         squared += out * out;
       }
       return squared;
@@ -218,7 +212,7 @@ namespace lacerta::mt
     }
     mesh::Point3 nearest = mesh::lerp(blade.tail, blade.head, best);
     for (unsigned int d = 0; d < 3; ++d)
-      nearest[d] = std::clamp(nearest[d], box_low[d], box_high[d]);
+      nearest[d] = std::clamp(nearest[d], box.lower[d], box.upper[d]);
     return nearest;
   }
 

@@ -1,5 +1,6 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/output_file.h>
+#include <lacerta/cut/geometry.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/postprocess/postprocessor.h>
@@ -257,20 +258,16 @@ namespace lacerta::view
     };
     if (has_tool)
       follow_the_tool();
-    simulator                  = std::make_unique<Simulator>(prm, options.scene_file);
-    const mesh::TetMesh  &mesh = simulator->get_scene().active_mesh();
-    std::array<double, 3> low{{1e300, 1e300, 1e300}}, high{{-1e300, -1e300, -1e300}};
-    for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
-      for (unsigned int d = 0; d < 3; ++d)
-      {
-        low[d]  = std::min(low[d], mesh.vertex(v)[d]);
-        high[d] = std::max(high[d], mesh.vertex(v)[d]);
-      }
-    object_size = mesh::distance(low, high);
+    simulator = std::make_unique<Simulator>(prm, options.scene_file);
+    cut::Box box;
+    for (const mesh::Point3 &x : simulator->get_scene().active_mesh().get_vertices())
+      box.extend(x);
+    object_size = mesh::distance(box.lower, box.upper);
     if (!has_tool)
     {
-      const double       z = high[2] + object_size + blade_parameters.length;
-      const double       x = 0.5 * (low[0] + high[0]), y = 0.5 * (low[1] + high[1]);
+      const double z = box.upper[2] + object_size + blade_parameters.length;
+      const double x = 0.5 * (box.lower[0] + box.upper[0]),
+                   y = 0.5 * (box.lower[1] + box.upper[1]);
       std::ostringstream keys;
       keys << std::setprecision(17);
       for (const double t : {0.0, 1.0})

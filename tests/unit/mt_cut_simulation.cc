@@ -6,14 +6,13 @@
 #include <lacerta/mt/multiresolution.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/scene/scene.h>
-#include <lacerta/simulator/simulator.h>
 
 #include <gtest/gtest.h>
 
+#include "mt_test_support.h"
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <numeric>
+#include <sstream>
 
 namespace lacerta
 {
@@ -29,23 +28,15 @@ namespace lacerta
     std::unique_ptr<scene::Scene>
     cut_slab_scene()
     {
-      const std::string file =
-        (std::filesystem::temp_directory_path() / "lacerta_mt_cut_simulation.prm")
-          .string();
-      {
-        std::ofstream out(file);
-        out << "include " LACERTA_SCENE_DIR "/square_lod.prm\n"
-            << "subsection Mesh\n  subsection Box\n    set Repetitions = 20, 20, 4\n"
-            << "  end\nend\n"
-            << "subsection Multiresolution\n  set Cache directory =\nend\n"
-            << "subsection Tool\n  set Type = scalpel\n  subsection Scalpel\n"
-            << "    set Keyframes = 0, 0.003, 0.07, 0.03, 0.003, 0.07, -0.01; "
-               "1, 0.003, -0.07, 0.03, 0.003, -0.07, -0.01\n  end\nend\n";
-      }
-      dealii::ParameterHandler prm;
-      Simulator::read_parameters(file, prm);
-      std::filesystem::remove(file);
-      return std::make_unique<scene::Scene>(prm, 1);
+      std::ostringstream text;
+      text << "include " LACERTA_SCENE_DIR "/square_lod.prm\n"
+           << "subsection Mesh\n  subsection Box\n    set Repetitions = 20, 20, 4\n"
+           << "  end\nend\n"
+           << "subsection Multiresolution\n  set Cache directory =\nend\n"
+           << "subsection Tool\n  set Type = scalpel\n  subsection Scalpel\n"
+           << "    set Keyframes = 0, 0.003, 0.07, 0.03, 0.003, 0.07, -0.01; "
+              "1, 0.003, -0.07, 0.03, 0.003, -0.07, -0.01\n  end\nend\n";
+      return test_support::scene_from_text("lacerta_mt_cut_simulation.prm", text.str());
     }
 
     /**

@@ -5,12 +5,10 @@
 #include <lacerta/cut/tool.h>
 #include <lacerta/mt/multiresolution.h>
 #include <lacerta/scene/scene.h>
-#include <lacerta/simulator/simulator.h>
 
 #include <gtest/gtest.h>
 
-#include <filesystem>
-#include <fstream>
+#include "mt_test_support.h"
 #include <sstream>
 
 namespace lacerta
@@ -25,24 +23,17 @@ namespace lacerta
     std::unique_ptr<scene::Scene>
     slab_scene(const std::string &multiresolution)
     {
-      const std::string file =
-        (std::filesystem::temp_directory_path() / "lacerta_mt_focus.prm").string();
-      {
-        std::ofstream out(file);
-        out << "include " LACERTA_SCENE_DIR "/square_lod.prm\n"
-            << "subsection Mesh\n  subsection Box\n    set Repetitions = 12, 12, 3\n"
-            << "  end\nend\n"
-            << "subsection Multiresolution\n  set Cache directory =\n"
-            << "  set Re-extraction interval = 1\n"
-            << multiresolution << "end\n"
-            << "subsection Tool\n  set Type = scalpel\n  subsection Scalpel\n"
-            << "    set Keyframes = 0, -0.04, 0, 0.045, -0.04, 0, 0.025; 1, -0.04, 0, "
-               "0.045, -0.04, 0, 0.025\n  end\nend\n";
-      }
-      dealii::ParameterHandler prm;
-      Simulator::read_parameters(file, prm);
-      std::filesystem::remove(file);
-      return std::make_unique<scene::Scene>(prm, 1);
+      std::ostringstream text;
+      text << "include " LACERTA_SCENE_DIR "/square_lod.prm\n"
+           << "subsection Mesh\n  subsection Box\n    set Repetitions = 12, 12, 3\n"
+           << "  end\nend\n"
+           << "subsection Multiresolution\n  set Cache directory =\n"
+           << "  set Re-extraction interval = 1\n"
+           << multiresolution << "end\n"
+           << "subsection Tool\n  set Type = scalpel\n  subsection Scalpel\n"
+           << "    set Keyframes = 0, -0.04, 0, 0.045, -0.04, 0, 0.025; 1, -0.04, 0, "
+              "0.045, -0.04, 0, 0.025\n  end\nend\n";
+      return test_support::scene_from_text("lacerta_mt_focus.prm", text.str());
     }
 
 

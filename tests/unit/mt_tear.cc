@@ -10,15 +10,13 @@
 #include <lacerta/mt/multiresolution.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/scene/scene.h>
-#include <lacerta/simulator/simulator.h>
 
 #include <gtest/gtest.h>
 
 #include "mt_test_support.h"
 #include "physics_test_support.h"
 #include <cmath>
-#include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <string>
 
 namespace lacerta
@@ -37,26 +35,19 @@ namespace lacerta
     std::unique_ptr<scene::Scene>
     slab_scene(const std::string &limit, const std::string &extra = "")
     {
-      const std::string file =
-        (std::filesystem::temp_directory_path() / "lacerta_mt_tear.prm").string();
-      {
-        std::ofstream out(file);
-        out << "subsection Mesh\n  set Source = box\n  subsection Box\n"
-            << "    set Lower corner = 0, 0, 0\n    set Upper corner = 1, 1, 0.25\n"
-            << "    set Repetitions = 8, 8, 2\n  end\nend\n"
-            << "subsection Material\n  set Density = 1000\n  set Youngs modulus = 1e4\n"
-            << "  set Maximum elongation = " << limit << "\nend\n"
-            << "subsection Multiresolution\n  set Enabled = true\n"
-            << "  set Cache directory =\n  set Query = uniform\n"
-            << "  subsection Uniform\n    set Cell size = 0\n  end\nend\n"
-            << "subsection Laceration\n  set Enabled = true\n  set Threshold h = 3\n"
-            << "end\n"
-            << extra;
-      }
-      dealii::ParameterHandler prm;
-      Simulator::read_parameters(file, prm);
-      std::filesystem::remove(file);
-      return std::make_unique<scene::Scene>(prm, 1);
+      std::ostringstream text;
+      text << "subsection Mesh\n  set Source = box\n  subsection Box\n"
+           << "    set Lower corner = 0, 0, 0\n    set Upper corner = 1, 1, 0.25\n"
+           << "    set Repetitions = 8, 8, 2\n  end\nend\n"
+           << "subsection Material\n  set Density = 1000\n  set Youngs modulus = 1e4\n"
+           << "  set Maximum elongation = " << limit << "\nend\n"
+           << "subsection Multiresolution\n  set Enabled = true\n"
+           << "  set Cache directory =\n  set Query = uniform\n"
+           << "  subsection Uniform\n    set Cell size = 0\n  end\nend\n"
+           << "subsection Laceration\n  set Enabled = true\n  set Threshold h = 3\n"
+           << "end\n"
+           << extra;
+      return test_support::scene_from_text("lacerta_mt_tear.prm", text.str());
     }
 
     /// Puts every particle at its rest position stretched by @p s along x about

@@ -6,17 +6,37 @@
 #include <lacerta/mt/lod.h>
 #include <lacerta/mt/lod_query.h>
 #include <lacerta/mt/multi_triangulation.h>
+#include <lacerta/scene/scene.h>
+#include <lacerta/simulator/simulator.h>
 
 #include <deal.II/base/parameter_handler.h>
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <string>
 
 namespace lacerta::test_support
 {
+  /**
+   * The scene of a parameter file whose text is @p parameters, written to a temporary
+   * file @p name (so that its `include` lines resolve as a scene file's) and removed.
+   */
+  inline std::unique_ptr<scene::Scene>
+  scene_from_text(const std::string &name, const std::string &parameters)
+  {
+    const std::string file = (std::filesystem::temp_directory_path() / name).string();
+    std::ofstream(file) << parameters;
+    dealii::ParameterHandler prm;
+    Simulator::read_parameters(file, prm);
+    std::filesystem::remove(file);
+    return std::make_unique<scene::Scene>(prm, 1);
+  }
+
+
   /// A level of detail query from a name and parameters, as a scene would make it.
   inline std::unique_ptr<mt::LodQuery>
   make_query(const std::string &name, const std::map<std::string, std::string> &values)

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <lacerta/cut/cut_record.h>
+#include <lacerta/cut/geometry.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/mt/lod.h>
 #include <lacerta/mt/lod_query.h>
@@ -182,8 +183,8 @@ namespace lacerta::mt
     std::unique_ptr<dealii::FunctionParser<3>> path;
     /// `Focus follows = tool`: the focus follows the blade, not the path.
     bool follows_tool = false;
-    /// The bounding box of the mesh at rest (lowest and highest corner).
-    mesh::Point3 box_low{}, box_high{};
+    /// The bounding box of the mesh at rest.
+    cut::Box     box;
     double       distance = 0;
     unsigned int interval = 1;
     /// The builder's `Maximum boundary error`, which the MT's cuts must reach past.
