@@ -2,8 +2,16 @@
 
 #include <deal.II/base/utilities.h>
 
+#include <algorithm>
+
 namespace lacerta::postprocess
 {
+  void
+  Postprocessor::parse_parameters(dealii::ParameterHandler &)
+  {
+  }
+
+
   bool
   Postprocessor::needs_energies(double) const
   {
@@ -15,6 +23,12 @@ namespace lacerta::postprocess
   Postprocessor::writes_state(double) const
   {
     return false;
+  }
+
+
+  void
+  Postprocessor::finish(const RunState &)
+  {
   }
 
 
@@ -33,12 +47,17 @@ namespace lacerta::postprocess
 
 
   std::vector<std::unique_ptr<Postprocessor>>
-  Postprocessor::create(dealii::ParameterHandler &prm)
+  Postprocessor::create(dealii::ParameterHandler       &prm,
+                        const std::vector<std::string> &required)
   {
     std::vector<std::unique_ptr<Postprocessor>> list;
     prm.enter_subsection("Postprocess");
-    for (const std::string &name :
-         dealii::Utilities::split_string_list(prm.get("List of postprocessors")))
+    std::vector<std::string> names =
+      dealii::Utilities::split_string_list(prm.get("List of postprocessors"));
+    for (auto r = required.rbegin(); r != required.rend(); ++r)
+      if (std::find(names.begin(), names.end(), *r) == names.end())
+        names.insert(names.begin(), *r);
+    for (const std::string &name : names)
       list.push_back(PostprocessorRegistry::create_and_parse(name, prm));
     prm.leave_subsection();
     return list;

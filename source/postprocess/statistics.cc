@@ -25,11 +25,6 @@ namespace lacerta::postprocess
       }
 
       void
-      parse_parameters(dealii::ParameterHandler &) override
-      {
-      }
-
-      void
       initialize(const std::string &output_directory, const bool test) override
       {
         file      = OutputFile(output_directory + "/statistics.csv");

@@ -108,6 +108,57 @@ namespace lacerta::scene
       if (multiresolution)
         lacerator->set_recorder(&cut_records);
     }
+    system_changed.connect([this](const SystemChange &change) { follow_change(change); });
+  }
+
+
+  void
+  Scene::follow_change(const SystemChange &change)
+  {
+    if (!change.reassembled())
+      for (auto &constraint : constraints)
+        constraint->follow_copies(change.copied_particles, *system);
+    if (change.cause == SystemChange::Cause::cut && lacerator)
+      lacerator->mesh_changed();
+    if (change.cause != SystemChange::Cause::cut)
+      restart_cutter();
+    if (change.reassembled() && lacerator)
+    {
+      // Particles the MT's cuts created: among them the lacerator finds those of its
+      // tears again.
+      const std::size_t first = multiresolution->multi_triangulation().first_cut_vertex();
+      const std::vector<std::uint32_t> &ids = multiresolution->active_vertices();
+      std::vector<std::uint8_t>         created(ids.size());
+      for (std::size_t i = 0; i < ids.size(); ++i)
+        created[i] = ids[i] >= first;
+      lacerator->particles_replaced(created);
+    }
+  }
+
+
+  cut::CutStepStatistics
+  Scene::cut(const cut::Blade &blade, const double t)
+  {
+    if (!cutter)
+      throw_error("Scene::cut(): the scene has no tool.");
+    cut::CutStepStatistics statistics = cutter->move_blade(blade);
+    if (statistics.changed)
+      system_changed(
+        SystemChange{SystemChange::Cause::cut, t, statistics.copied_particles});
+    return statistics;
+  }
+
+
+  cut::LacerationStatistics
+  Scene::lacerate(const double t)
+  {
+    if (!lacerator)
+      throw_error("Scene::lacerate(): the scene has no lacerations.");
+    cut::LacerationStatistics statistics = lacerator->check();
+    if (statistics.changed)
+      system_changed(
+        SystemChange{SystemChange::Cause::laceration, t, statistics.copied_particles});
+    return statistics;
   }
 
 
@@ -146,22 +197,10 @@ namespace lacerta::scene
     transfer(old_x, old_v, system->position, system->velocity);
     system->enforce_constraints(t, system->position.data(), system->velocity.data());
     system->update_force_model(n_threads);
-    restart_cutter();
-    if (lacerator)
-    {
-      // Particles the MT's cuts created: among them the lacerator finds those of its
-      // tears again.
-      const std::size_t first = multiresolution->multi_triangulation().first_cut_vertex();
-      const std::vector<std::uint32_t> &ids = multiresolution->active_vertices();
-      std::vector<std::uint8_t>         created(ids.size());
-      for (std::size_t i = 0; i < ids.size(); ++i)
-        created[i] = ids[i] >= first;
-      lacerator->particles_replaced(created);
-    }
   }
 
 
-  std::optional<Scene::MultiresolutionCut>
+  std::optional<MultiresolutionCut>
   Scene::update_multiresolution_after_cut(const double t)
   {
     // Tears are complete strokes: only a scalpel's stroke in progress makes it wait.
@@ -185,6 +224,10 @@ namespace lacerta::scene
                                 cut_mesh, old_x, old_v, active_mesh(), x, v);
                             });
     result.pieces_after = cut::count_components(active_mesh());
+    result.n_tets       = active_mesh().n_tets();
+    result.n_particles  = system->n_particles();
+    result.mass         = std::accumulate(system->mass.begin(), system->mass.end(), 0.0);
+    system_changed(SystemChange{SystemChange::Cause::multiresolution_cut, t, {}});
     return result;
   }
 
@@ -282,6 +325,7 @@ namespace lacerta::scene
       { multiresolution->transfer_state(old_vertices, old_x, old_v, x, v); });
     multiresolution->print_change(
       out, t, std::accumulate(system->mass.begin(), system->mass.end(), 0.0));
+    system_changed(SystemChange{SystemChange::Cause::level_of_detail, t, {}});
     return true;
   }
 
@@ -300,14 +344,6 @@ namespace lacerta::scene
         force->add_forces(t, *system);
     for (const auto &constraint : constraints)
       constraint->add_forces(t, *system);
-  }
-
-
-  void
-  Scene::follow_cut(const std::vector<std::array<unsigned int, 2>> &copies)
-  {
-    for (auto &constraint : constraints)
-      constraint->follow_copies(copies, *system);
   }
 
 
@@ -332,5 +368,23 @@ namespace lacerta::scene
           << " particles, "
           << (constraint->prescribes_motion() ? "prescribed motion" : "applied force")
           << "\n";
+  }
+
+
+  std::string
+  SystemChange::describe() const
+  {
+    switch (cause)
+    {
+      case Cause::cut:
+        return "the cut";
+      case Cause::laceration:
+        return "the laceration";
+      case Cause::multiresolution_cut:
+        return "the MT update after the stroke";
+      case Cause::level_of_detail:
+        return "the re-extraction of the level of detail";
+    }
+    return "a change of the particle system";
   }
 } // namespace lacerta::scene

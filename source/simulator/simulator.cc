@@ -293,16 +293,32 @@ namespace lacerta
     prm.print_parameters(copy, dealii::ParameterHandler::ShortPRM);
     write_file_atomically(output_directory + "/parameters.prm", copy.str());
 
-    scene          = std::make_unique<scene::Scene>(prm, n_threads);
-    integrator     = physics::Integrator::create(prm);
-    postprocessors = postprocess::Postprocessor::create(prm);
+    scene        = std::make_unique<scene::Scene>(prm, n_threads);
+    step_results = std::make_unique<StepResults>();
+    integrator   = physics::Integrator::create(prm);
+    // A scene that cuts or tears always prints the paper's tables.
+    postprocessors =
+      postprocess::Postprocessor::create(prm,
+                                         scene->cutter || scene->lacerator
+                                           ? std::vector<std::string>{"cut tables"}
+                                           : std::vector<std::string>{});
     if (redistribute_mass)
       mass_balancer =
         std::make_unique<physics::MassBalancer>(*scene->system, redistribution_reach);
     integrator->initialize(*scene->system);
     for (auto &p : postprocessors)
       p->initialize(output_directory, test_mode);
+    scene->system_changed.connect([this](const scene::SystemChange &change)
+                                  { on_system_changed(change); });
   }
+
+
+  struct Simulator::StepResults
+  {
+    std::optional<cut::CutStepStatistics>    cut;
+    std::optional<cut::LacerationStatistics> tear;
+    std::optional<scene::MultiresolutionCut> mt_cut;
+  };
 
 
   Simulator::~Simulator() = default;
@@ -398,346 +414,290 @@ namespace lacerta
   void
   Simulator::run()
   {
-    dealii::TimerOutput      timer(std::cout,
-                              dealii::TimerOutput::never,
-                              dealii::TimerOutput::wall_times);
+    start_run();
+    for (step = 1; step <= n_steps; ++step)
+    {
+      const double dt         = std::min(time_step, end_time - time);
+      const auto   step_start = Clock::now();
+      begin_step();
+      if (scene->cutter)
+        move_tool(dt);
+      if (scene->lacerator)
+        lacerate(dt);
+      integrate(dt);
+      time = (step == n_steps) ? end_time : time + dt;
+      update_multiresolution();
+      state.step         = step;
+      state.time         = time;
+      state.time_step    = dt;
+      state.step_seconds = seconds_since(step_start);
+      postprocess();
+      report_progress();
+      if (signals.stop && signals.stop())
+        break;
+    }
+    finish_run();
+  }
+
+
+  void
+  Simulator::start_run()
+  {
     physics::ParticleSystem &system = *scene->system;
     scene->print_summary(std::cout);
     if (scene->multiresolution)
       scene->multiresolution->print_summary(std::cout, test_mode);
     std::cout << "Integrator: "
               << "time step " << time_step << " s, end time " << end_time << " s\n";
-    unsigned int substeps = choose_substeps();
+    timer          = std::make_unique<dealii::TimerOutput>(std::cout,
+                                                  dealii::TimerOutput::never,
+                                                  dealii::TimerOutput::wall_times);
+    state          = postprocess::RunState();
+    state.substeps = choose_substeps();
     if (scene->multiresolution)
       print_stability_against_full_mesh();
-
-    physics::BlowUpMonitor monitor(system, energy_tolerance);
-    const auto             check = [&](const unsigned int step)
-    {
-      if (!check_invariants)
-        return;
-      const std::string problem = cut::check_invariants(scene->active_mesh(),
-                                                        system,
-                                                        scene->expected_volume(),
-                                                        scene->integral_of_density);
-      if (!problem.empty())
-        throw_error("Check invariants: after step ", step, ": ", problem, ".");
-    };
+    monitor = std::make_unique<physics::BlowUpMonitor>(system, energy_tolerance);
     check(0);
-    // The paper's Table 1, averaged over the steps that cut.
-    unsigned int       cutting_steps      = 0;
-    unsigned long long n_integrator_steps = 0;
-    double             sum_cut = 0, sum_created = 0, sum_update = 0, sum_relax = 0;
-    unsigned int       n_tears = 0, n_torn = 0, n_tear_created = 0;
-    double             sum_tear = 0;
-    // The paper's Table 2 on a multiresolution model: the cutter's work on the level of
-    // detail during a stroke (CuT, CrT, TetUp), then the MT update after it (SF,
-    // MT-DAGUpd); per stroke and summed over the run.
-    unsigned int stroke_cut = 0, stroke_created = 0, n_mt_updates = 0;
-    double       stroke_update         = 0;
-    unsigned int total_split_fragments = 0, total_mt_cut = 0, total_mt_created = 0;
-    double       total_tet_update = 0, total_mt_update = 0;
-    postprocess::RunState state;
     state.mesh     = &scene->active_mesh();
     state.system   = &system;
     state.material = &scene->material;
+    state.scene    = scene.get();
     state.blade    = scene->cutter ? &scene->cutter->blade() : nullptr;
-    state.substeps = substeps;
-
-    // After a topology change or a new level of detail the particles and springs are
-    // others: the integrator's scratch space and the stability limit start afresh (the
-    // invariants are checked first if @p check_now). The blow-up monitor checks the new
-    // state against its ledger at once, so that a change that puts particles far off
-    // stops the run naming it (@p cause), then restarts its ledger.
-    // Mass redistribution over the run: the most mass held away from the lumped masses
-    // at one change (each redistribution starts afresh from them), and the particles
-    // left above the target at the last one.
-    double       largest_moved   = 0;
-    unsigned int last_unresolved = 0, n_balances = 0;
-    const auto   system_changed = [&](const unsigned int step,
-                                    const double       at,
-                                    const bool         check_now,
-                                    const std::string &cause)
-    {
-      if (mass_balancer)
-      {
-        const physics::MassBalanceStatistics b = mass_balancer->balance(system);
-        largest_moved                          = std::max(largest_moved, b.moved);
-        last_unresolved                        = b.unresolved;
-        ++n_balances;
-      }
-      if (check_now)
-        check(step);
-      integrator->initialize(system);
-      monitor.restart(system, step, at, cause);
-      substeps = state.substeps = choose_substeps();
-      state.mesh                = &scene->active_mesh();
-    };
-    const auto evaluate_energies = [&]
-    {
-      state.kinetic_energy    = system.kinetic_energy();
-      state.elastic_energy    = system.elastic_energy();
-      state.body_force_energy = system.body_force_energy();
-      state.input_work        = monitor.input_work();
-    };
-    const auto postprocess = [&](const unsigned int step)
-    {
-      bool writes = false, needs_energies = false;
-      for (const auto &p : postprocessors)
-      {
-        writes |= p->writes_state(state.time);
-        needs_energies |= p->needs_energies(state.time);
-      }
-      if (writes || step % check_interval == 0)
-      {
-        monitor.check(system, step, state.time);
-        // The limit falls when an element collapses (the geometric stiffness of a
-        // strongly compressed spring) without any change of the system: keeping the
-        // sub-steps chosen at the last change let the severed kidney pole blow up.
-        if (substep_when_unstable)
-          substeps = state.substeps = choose_substeps(substeps);
-      }
-      if (needs_energies)
-      {
-        evaluate_energies();
-        if (!std::isfinite(state.kinetic_energy + state.elastic_energy))
-          monitor.check(system, step, state.time);
-      }
-      dealii::TimerOutput::Scope scope(timer, "output");
-      for (auto &p : postprocessors)
-        p->execute(state);
-      if (signals.post_step)
-        signals.post_step(state);
-    };
-
-    postprocess(0);
-    const double       epsilon = 1e-9 * time_step;
-    const unsigned int n_steps =
-      static_cast<unsigned int>(std::ceil((end_time - epsilon) / time_step));
-    const unsigned int n_reports     = 10;
-    const bool         show_progress = !test_mode && isatty(STDERR_FILENO);
-    const auto         run_start     = Clock::now();
-    double             last_progress = 0;
+    step           = 0;
+    time           = 0;
+    steps_done     = 0;
+    postprocess();
+    const double epsilon = 1e-9 * time_step;
+    n_steps = static_cast<unsigned int>(std::ceil((end_time - epsilon) / time_step));
+    show_progress = !test_mode && isatty(STDERR_FILENO);
+    run_start     = Clock::now();
+    last_progress = 0;
     std::cout << "Running " << n_steps << " steps\n";
+  }
 
-    double       time       = 0;
-    unsigned int steps_done = 0;
-    for (unsigned int step = 1; step <= n_steps; ++step)
+
+  void
+  Simulator::begin_step()
+  {
+    // This step's columns start at zero; what the run carries (the mesh, the blade, the
+    // sub-steps, the energies last evaluated) stays.
+    state.cut      = nullptr;
+    state.tear     = nullptr;
+    state.mt_cut   = nullptr;
+    state.cut_tets = state.created_tets = 0;
+    state.update_seconds = state.cut_step_seconds = 0;
+    state.over_limit = state.tears = state.torn_tets = state.tear_created_tets = 0;
+    state.tear_seconds = state.mt_update_seconds = state.integration_seconds = 0;
+    state.split_fragments                                                    = 0;
+    *step_results = StepResults();
+  }
+
+
+  void
+  Simulator::move_tool(const double dt)
+  {
+    dealii::TimerOutput::Scope scope(*timer, "cut");
+    std::optional<cut::Blade>  blade;
+    if (signals.blade)
+      blade = signals.blade(time + dt);
+    auto &cut          = step_results->cut;
+    cut                = scene->cut(blade ? *blade : scene->tool->blade(time + dt), time);
+    state.cut          = &*cut;
+    state.cut_tets     = cut->cut_tets;
+    state.created_tets = cut->created_tets;
+    state.update_seconds = cut->update_seconds;
+    state.cut_step_seconds =
+      cut->search_seconds + cut->update_seconds + cut->reinit_seconds;
+  }
+
+
+  void
+  Simulator::lacerate(const double)
+  {
+    dealii::TimerOutput::Scope scope(*timer, "laceration");
+    auto                      &tear = step_results->tear;
+    tear                            = scene->lacerate(time);
+    state.over_limit                = tear->over_limit;
+    if (!tear->changed)
+      return;
+    state.tear              = &*tear;
+    state.tears             = 1;
+    state.torn_tets         = tear->cut_tets;
+    state.tear_created_tets = tear->created_tets;
+    state.tear_seconds      = tear->update_seconds;
+  }
+
+
+  void
+  Simulator::integrate(const double dt)
+  {
+    dealii::TimerOutput::Scope scope(*timer, "integration");
+    physics::ParticleSystem   &system = *scene->system;
+    const auto                 start  = Clock::now();
+    const double               h      = dt / state.substeps;
+    system.force_seconds              = 0;
+    n_integrator_steps += state.substeps;
+    for (unsigned int k = 0; k < state.substeps; ++k)
     {
-      const double dt         = std::min(time_step, end_time - time);
-      const auto   step_start = Clock::now();
-      state.cut_tets = state.created_tets = 0;
-      state.update_seconds = state.cut_step_seconds = 0;
-      state.over_limit = state.tears = state.torn_tets = state.tear_created_tets = 0;
-      state.tear_seconds                                                         = 0;
-      state.split_fragments                                                      = 0;
-      state.mt_update_seconds                                                    = 0;
-      bool cut_changed                                                           = false;
-      if (scene->cutter)
-      {
-        dealii::TimerOutput::Scope scope(timer, "cut");
-        std::optional<cut::Blade>  blade;
-        if (signals.blade)
-          blade = signals.blade(time + dt);
-        const cut::CutStepStatistics cut =
-          scene->cutter->move_blade(blade ? *blade : scene->tool->blade(time + dt));
-        state.cut_tets       = cut.cut_tets;
-        state.created_tets   = cut.created_tets;
-        state.update_seconds = cut.update_seconds;
-        state.cut_step_seconds =
-          cut.search_seconds + cut.update_seconds + cut.reinit_seconds;
-        cut_changed = cut.changed;
-        stroke_cut += cut.cut_tets;
-        stroke_created += cut.created_tets;
-        stroke_update += cut.update_seconds;
-        if (cut.changed)
-        {
-          // The constraints take over the copies of their particles.
-          scene->follow_cut(cut.copied_particles);
-          system_changed(step, time, true, "the cut");
-        }
-      }
-      if (scene->lacerator)
-      {
-        dealii::TimerOutput::Scope scope(timer, "laceration");
-        if (cut_changed)
-          scene->lacerator->mesh_changed();
-        const cut::LacerationStatistics tear = scene->lacerator->check();
-        state.over_limit                     = tear.over_limit;
-        if (tear.changed)
-        {
-          state.tears             = 1;
-          state.torn_tets         = tear.cut_tets;
-          state.tear_created_tets = tear.created_tets;
-          state.tear_seconds      = tear.update_seconds;
-          ++n_tears;
-          n_torn += tear.cut_tets;
-          n_tear_created += tear.created_tets;
-          sum_tear += tear.update_seconds;
-          // On a multiresolution model the tear's split goes to the MT like a stroke's
-          // (doc/lacerations.md): Table 2's CuT, CrT and TetUp include it.
-          stroke_cut += tear.cut_tets;
-          stroke_created += tear.created_tets;
-          stroke_update += tear.update_seconds;
-          std::cout << "Laceration at t = " << time + dt
-                    << " s: " << (tear.continued ? "continued" : "started")
-                    << " at the spring " << tear.seed_a << "-" << tear.seed_b << " ("
-                    << tear.seed_ratio << " times its maximum elongation, "
-                    << tear.over_limit << " surface springs past their limit); "
-                    << tear.advances << " advances, "
-                    << (tear.complete ? "through" : "stopped inside") << "; "
-                    << tear.cut_tets << " tetrahedra split into " << tear.created_tets
-                    << "; mesh components "
-                    << cut::count_components(scene->active_mesh());
-          if (!test_mode)
-            std::cout << "; " << 1e3 * tear.update_seconds << " ms";
-          std::cout << "\n";
-          // As after a cut; the scalpel's search structures must see the torn faces.
-          scene->follow_cut(tear.copied_particles);
-          scene->restart_cutter();
-          system_changed(step, time, true, "the laceration");
-        }
-      }
-      const auto   relax_start = Clock::now();
-      const double h           = dt / substeps;
-      {
-        dealii::TimerOutput::Scope scope(timer, "integration");
-        system.force_seconds = 0;
-        n_integrator_steps += substeps;
-        for (unsigned int k = 0; k < substeps; ++k)
-        {
-          scene->update_loads(time + k * h);
-          integrator->step(system, time + k * h, h);
-        }
-      }
-      if (state.cut_tets > 0)
-      {
-        ++cutting_steps;
-        sum_cut += state.cut_tets;
-        sum_created += state.created_tets;
-        sum_update += state.update_seconds;
-        sum_relax += seconds_since(relax_start);
-      }
-      time = (step == n_steps) ? end_time : time + dt;
-      if (const auto mt_cut = scene->update_multiresolution_after_cut(time))
-      {
-        // The simulation moves to the MT's version of the cut level of detail: new
-        // particles and springs, as after a re-extraction.
-        ++n_mt_updates;
-        state.split_fragments   = mt_cut->update.split_fragments;
-        state.mt_update_seconds = mt_cut->update.seconds;
-        total_split_fragments += mt_cut->update.split_fragments;
-        total_mt_cut += mt_cut->update.cut_tets;
-        total_mt_created += mt_cut->update.created_tets;
-        total_tet_update += stroke_update;
-        total_mt_update += mt_cut->update.seconds;
-        std::cout << "MT update after the stroke at t = " << time << " s: SF "
-                  << mt_cut->update.split_fragments << ", CuT " << stroke_cut << ", CrT "
-                  << stroke_created;
-        if (!test_mode)
-          std::cout << ", TetUp " << 1e3 * stroke_update << " ms, MT-DAGUpd "
-                    << 1e3 * mt_cut->update.seconds << " ms";
-        std::cout << "; MT tetrahedra cut " << mt_cut->update.cut_tets << ", created "
-                  << mt_cut->update.created_tets << ", vertices added "
-                  << mt_cut->update.new_vertices << "; level of detail "
-                  << scene->active_mesh().n_tets() << " tetrahedra, "
-                  << system.n_particles() << " particles (" << mt_cut->transfer.copied
-                  << " copied, " << mt_cut->transfer.interpolated
-                  << " interpolated), mass "
-                  << std::accumulate(system.mass.begin(), system.mass.end(), 0.0)
-                  << " kg; mesh components " << mt_cut->pieces_after
-                  << " (the cutter's mesh had " << mt_cut->pieces_before << ")\n";
-        stroke_cut = stroke_created = 0;
-        stroke_update               = 0;
-        system_changed(step, time, true, "the MT update after the stroke");
-      }
-      if (scene->update_level_of_detail(time, step, std::cout))
-        system_changed(step, time, false, "the re-extraction of the level of detail");
-      state.step = step;
-      state.time = time;
-      // The cutter is made anew after a tear (Scene::restart_cutter()).
-      state.blade         = scene->cutter ? &scene->cutter->blade() : nullptr;
-      state.time_step     = dt;
-      state.step_seconds  = seconds_since(step_start);
-      state.force_seconds = system.force_seconds;
-      postprocess(step);
-      steps_done = step;
-
-      if (step * n_reports / n_steps != (step - 1) * n_reports / n_steps
-          || step == n_steps)
-      {
-        monitor.check(system, step, time);
-        evaluate_energies();
-        const auto [displacement, where] = largest_displacement(system);
-        std::cout << "t = " << time << " s: kinetic energy " << state.kinetic_energy
-                  << " J, elastic energy " << state.elastic_energy
-                  << " J, largest displacement " << displacement << " m (particle "
-                  << where << ")\n";
-      }
-      const double elapsed = seconds_since(run_start);
-      if (show_progress && elapsed > 2 && elapsed - last_progress > 1)
-      {
-        last_progress = elapsed;
-        std::fprintf(stderr,
-                     "\rstep %u/%u  t = %.4g s  %3.0f%%  %.0f s left   ",
-                     step,
-                     n_steps,
-                     time,
-                     100.0 * step / n_steps,
-                     elapsed * (n_steps - step) / step);
-      }
-      if (signals.stop && signals.stop())
-        break;
+      scene->update_loads(time + k * h);
+      integrator->step(system, time + k * h, h);
     }
+    state.integration_seconds = seconds_since(start);
+    state.force_seconds       = system.force_seconds;
+  }
+
+
+  void
+  Simulator::update_multiresolution()
+  {
+    if (!scene->multiresolution)
+      return;
+    auto &mt_cut = step_results->mt_cut;
+    if ((mt_cut = scene->update_multiresolution_after_cut(time)))
+    {
+      state.mt_cut            = &*mt_cut;
+      state.split_fragments   = mt_cut->update.split_fragments;
+      state.mt_update_seconds = mt_cut->update.seconds;
+    }
+    scene->update_level_of_detail(time, step, std::cout);
+    // The cutter is made anew on a new level of detail (Scene::system_changed).
+    state.blade = scene->cutter ? &scene->cutter->blade() : nullptr;
+  }
+
+
+  void
+  Simulator::on_system_changed(const scene::SystemChange &change)
+  {
+    physics::ParticleSystem &system = *scene->system;
+    if (mass_balancer)
+    {
+      const physics::MassBalanceStatistics b = mass_balancer->balance(system);
+      redistribution.largest_moved   = std::max(redistribution.largest_moved, b.moved);
+      redistribution.last_unresolved = b.unresolved;
+      ++redistribution.n_balances;
+    }
+    // A new level of detail is checked by its extraction; a local change here.
+    if (change.cause != scene::SystemChange::Cause::level_of_detail)
+      check(step);
+    integrator->initialize(system);
+    // The blow-up monitor checks the new state against its ledger at once, so that a
+    // change that puts particles far off stops the run naming it, then restarts.
+    monitor->restart(system, step, change.time, change.describe());
+    state.substeps = choose_substeps();
+    state.mesh     = &scene->active_mesh();
+    state.blade    = scene->cutter ? &scene->cutter->blade() : nullptr;
+  }
+
+
+  void
+  Simulator::check(const unsigned int at_step) const
+  {
+    if (!check_invariants)
+      return;
+    const std::string problem = cut::check_invariants(scene->active_mesh(),
+                                                      *scene->system,
+                                                      scene->expected_volume(),
+                                                      scene->integral_of_density);
+    if (!problem.empty())
+      throw_error("Check invariants: after step ", at_step, ": ", problem, ".");
+  }
+
+
+  void
+  Simulator::evaluate_energies()
+  {
+    const physics::ParticleSystem &system = *scene->system;
+    state.kinetic_energy                  = system.kinetic_energy();
+    state.elastic_energy                  = system.elastic_energy();
+    state.body_force_energy               = system.body_force_energy();
+    state.input_work                      = monitor->input_work();
+  }
+
+
+  void
+  Simulator::postprocess()
+  {
+    physics::ParticleSystem &system = *scene->system;
+    bool                     writes = false, needs_energies = false;
+    for (const auto &p : postprocessors)
+    {
+      writes |= p->writes_state(state.time);
+      needs_energies |= p->needs_energies(state.time);
+    }
+    if (writes || step % check_interval == 0)
+    {
+      monitor->check(system, step, state.time);
+      // The limit falls when an element collapses (the geometric stiffness of a
+      // strongly compressed spring) without any change of the system: keeping the
+      // sub-steps chosen at the last change let the severed kidney pole blow up.
+      if (substep_when_unstable)
+        state.substeps = choose_substeps(state.substeps);
+    }
+    if (needs_energies)
+    {
+      evaluate_energies();
+      if (!std::isfinite(state.kinetic_energy + state.elastic_energy))
+        monitor->check(system, step, state.time);
+    }
+    dealii::TimerOutput::Scope scope(*timer, "output");
+    for (auto &p : postprocessors)
+      p->execute(state);
+    if (signals.post_step)
+      signals.post_step(state);
+  }
+
+
+  void
+  Simulator::report_progress()
+  {
+    steps_done                               = step;
+    const unsigned int             n_reports = 10;
+    const physics::ParticleSystem &system    = *scene->system;
+    if (step * n_reports / n_steps != (step - 1) * n_reports / n_steps || step == n_steps)
+    {
+      monitor->check(system, step, time);
+      evaluate_energies();
+      const auto [displacement, where] = largest_displacement(system);
+      std::cout << "t = " << time << " s: kinetic energy " << state.kinetic_energy
+                << " J, elastic energy " << state.elastic_energy
+                << " J, largest displacement " << displacement << " m (particle " << where
+                << ")\n";
+    }
+    const double elapsed = seconds_since(run_start);
+    if (show_progress && elapsed > 2 && elapsed - last_progress > 1)
+    {
+      last_progress = elapsed;
+      std::fprintf(stderr,
+                   "\rstep %u/%u  t = %.4g s  %3.0f%%  %.0f s left   ",
+                   step,
+                   n_steps,
+                   time,
+                   100.0 * step / n_steps,
+                   elapsed * (n_steps - step) / step);
+    }
+  }
+
+
+  void
+  Simulator::finish_run()
+  {
+    const physics::ParticleSystem &system = *scene->system;
     if (show_progress && last_progress > 0)
       std::fprintf(stderr, "\n");
-
     std::cout << "Done: " << steps_done << " steps, " << n_integrator_steps
               << " integrator steps\n";
-    if (mass_balancer && n_balances > 0)
+    if (mass_balancer && redistribution.n_balances > 0)
     {
       const double total = std::accumulate(system.mass.begin(), system.mass.end(), 0.0);
-      std::cout << "Mass redistribution: " << n_balances << " topology changes; at most "
-                << largest_moved << " kg away from the lumped masses at one ("
-                << 100 * largest_moved / total << " % of the mass); " << last_unresolved
+      std::cout << "Mass redistribution: " << redistribution.n_balances
+                << " topology changes; at most " << redistribution.largest_moved
+                << " kg away from the lumped masses at one ("
+                << 100 * redistribution.largest_moved / total << " % of the mass); "
+                << redistribution.last_unresolved
                 << " particles above the target after the last\n";
     }
-    if (scene->cutter)
-    {
-      std::cout << "Cut summary (Table 1 columns, averages over the " << cutting_steps
-                << " steps that cut): MS " << scene->active_mesh().n_tets() << ", CuT "
-                << (cutting_steps ? sum_cut / cutting_steps : 0.0) << ", CrT "
-                << (cutting_steps ? sum_created / cutting_steps : 0.0);
-      if (!test_mode && cutting_steps > 0)
-        std::cout << ", UpdT " << 1e3 * sum_update / cutting_steps << " ms, RxT "
-                  << 1e3 * sum_relax / cutting_steps << " ms";
-      if (scene->multiresolution)
-        std::cout << "; " << n_mt_updates
-                  << " MT updates (Table 2 columns: totals, times per stroke): SF "
-                  << total_split_fragments << ", MT tetrahedra cut " << total_mt_cut
-                  << ", created " << total_mt_created
-                  << (scene->cut_pending() ? " (a stroke still waits for its update)"
-                                           : "");
-      if (!test_mode && n_mt_updates > 0)
-        std::cout << ", TetUp " << 1e3 * total_tet_update / n_mt_updates
-                  << " ms, MT-DAGUpd " << 1e3 * total_mt_update / n_mt_updates << " ms";
-      // The pieces' rest volumes show what a cut separated (a punched hole).
-      const std::vector<double> pieces = cut::component_volumes(scene->active_mesh());
-      std::cout << "; mesh components " << pieces.size() << ", rest volumes (m^3)";
-      for (const double v : pieces)
-        std::cout << " " << v;
-      std::cout << "\n";
-    }
-    if (scene->lacerator)
-    {
-      std::cout << "Laceration summary: " << n_tears << " tears, " << n_torn
-                << " tetrahedra split into " << n_tear_created;
-      if (!test_mode && n_tears > 0)
-        std::cout << ", " << 1e3 * sum_tear / n_tears << " ms per tear";
-      std::cout << "; mesh " << scene->active_mesh().n_tets()
-                << " tetrahedra, components "
-                << cut::count_components(scene->active_mesh()) << "\n";
-    }
+    for (auto &p : postprocessors)
+      p->finish(state);
     if (!test_mode)
     {
       const double wall = seconds_since(run_start);
@@ -745,7 +705,7 @@ namespace lacerta
                 << double(system.springs.size()) * integrator->n_evaluations_per_step()
                      * n_integrator_steps / wall
                 << " springs/s (whole loop)\n";
-      timer.print_summary();
+      timer->print_summary();
     }
   }
 } // namespace lacerta

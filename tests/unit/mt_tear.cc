@@ -72,13 +72,7 @@ namespace lacerta
     cut::LacerationStatistics
     check_for_tears(scene::Scene &scene)
     {
-      const cut::LacerationStatistics s = scene.lacerator->check();
-      if (s.changed)
-      {
-        scene.follow_cut(s.copied_particles);
-        scene.restart_cutter();
-      }
-      return s;
+      return scene.lacerate(0);
     }
 
     /// The scene's particle system on its active mesh keeps every invariant.
@@ -327,13 +321,7 @@ namespace lacerta
     const unsigned int n_steps = 30;
     for (unsigned int k = 1; k <= n_steps; ++k)
     {
-      const cut::CutStepStatistics c =
-        scene->cutter->move_blade(scene->tool->blade(double(k) / n_steps));
-      if (c.changed)
-      {
-        scene->follow_cut(c.copied_particles);
-        scene->lacerator->mesh_changed();
-      }
+      scene->cut(scene->tool->blade(double(k) / n_steps), 0);
       expect_scene_invariants(*scene, "scalpel step " + std::to_string(k));
       ASSERT_FALSE(::testing::Test::HasFailure());
     }

@@ -21,11 +21,15 @@ namespace lacerta::physics
 namespace lacerta::scene
 {
   class Material;
-}
+  class Scene;
+  struct MultiresolutionCut;
+} // namespace lacerta::scene
 namespace lacerta::cut
 {
   struct Blade;
-}
+  struct CutStepStatistics;
+  struct LacerationStatistics;
+} // namespace lacerta::cut
 
 namespace lacerta::postprocess
 {
@@ -66,6 +70,17 @@ namespace lacerta::postprocess
     /// fragments split (SF) and its wall time (MT-DAGUpd, s); zero at other steps.
     unsigned int split_fragments   = 0;
     double       mt_update_seconds = 0;
+    /// Wall time of this step's integration (s).
+    double integration_seconds = 0;
+    /// The scene: its tool, cutter, lacerator and multiresolution model.
+    const scene::Scene *scene = nullptr;
+    /**
+     * What this step's blade motion, tear and MT update after a stroke did in full, or
+     * nullptr where the step had none; valid during execute() only.
+     */
+    const cut::CutStepStatistics    *cut    = nullptr;
+    const cut::LacerationStatistics *tear   = nullptr;
+    const scene::MultiresolutionCut *mt_cut = nullptr;
   };
 
 
@@ -84,9 +99,9 @@ namespace lacerta::postprocess
 
     virtual ~Postprocessor() = default;
 
-    /// Reads the plugin's parameters from its subsection.
+    /// Reads the plugin's parameters from its subsection (by default, none).
     virtual void
-    parse_parameters(dealii::ParameterHandler &prm) = 0;
+    parse_parameters(dealii::ParameterHandler &prm);
 
     /**
      * Prepares output into @p output_directory; in @p test_mode nothing that depends
@@ -108,13 +123,21 @@ namespace lacerta::postprocess
     virtual void
     execute(const RunState &state) = 0;
 
+    /// Called once when the run ends, with the last state (summaries).
+    virtual void
+    finish(const RunState &state);
+
     /// Declares `subsection Postprocess` with the list and every plugin's subsection.
     static void
     declare_parameters(dealii::ParameterHandler &prm);
 
-    /// Creates the postprocessors listed in `subsection Postprocess`.
+    /**
+     * Creates the postprocessors listed in `subsection Postprocess`, preceded by those
+     * of @p required the list does not name (what the scene needs whatever the list
+     * says).
+     */
     static std::vector<std::unique_ptr<Postprocessor>>
-    create(dealii::ParameterHandler &prm);
+    create(dealii::ParameterHandler &prm, const std::vector<std::string> &required = {});
   };
 
   /// The registry of postprocessors.

@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include <lacerta/base/signal.h>
 #include <lacerta/cut/cutter.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/mt/cut_state_transfer.h>
@@ -11,6 +12,7 @@
 #include <lacerta/scene/body_force.h>
 #include <lacerta/scene/constraint.h>
 #include <lacerta/scene/material.h>
+#include <lacerta/scene/system_change.h>
 
 #include <array>
 #include <memory>
@@ -31,10 +33,27 @@ namespace lacerta::cut
 {
   class Tool;
   class Lacerator;
+  struct LacerationStatistics;
 } // namespace lacerta::cut
 
 namespace lacerta::scene
 {
+  /// What Scene::update_multiresolution_after_cut() did.
+  struct MultiresolutionCut
+  {
+    /// The MT update (SF, MT tetrahedra cut and created, MT-DAGUpd).
+    mt::MtCutter::Statistics update;
+    /// How the particles' state reached the MT's version of the cut level of detail.
+    mt::CutTransferReport transfer;
+    /// Connected pieces of the cutter's mesh before the switch and of the MT's
+    /// version after it (they differ where the MT update left a bridge).
+    unsigned int pieces_before = 0, pieces_after = 0;
+    /// The level of detail the system moved to: tetrahedra, particles and mass (kg).
+    unsigned int n_tets = 0, n_particles = 0;
+    double       mass = 0;
+  };
+
+
   /**
    * Builds and owns what a parameter file describes: the mesh (numbered spatially), the
    * material, the particle system with its masses (3.1) and springs (3.2), the
@@ -57,30 +76,49 @@ namespace lacerta::scene
      */
     Scene(dealii::ParameterHandler &prm, unsigned int n_threads);
 
+    /// A scene is neither copied nor moved: its subscribers hold its address.
+    Scene(const Scene &) = delete;
+    Scene &
+    operator=(const Scene &) = delete;
+
     ~Scene();
+
+    /**
+     * Emitted after every change of the particle system (a cut, a tear, the MT update
+     * after a stroke, a new level of detail), once the scene has followed it itself:
+     * the constraints take over the copies of their particles, the cutter restarts on
+     * a new mesh, the lacerator learns what changed. Subscribers (the simulator's
+     * integrator and stability control, a viewer) connect to it; the scene's own
+     * reaction is connected first.
+     */
+    Signal<const SystemChange &> system_changed;
+
+    /**
+     * Moves the scalpel's blade to @p blade (cut::Cutter::move_blade()) on the state at
+     * time @p t and cuts what it sweeps; if the mesh changed, emits system_changed.
+     * Requires a tool.
+     */
+    cut::CutStepStatistics
+    cut(const cut::Blade &blade, double t);
+
+    /**
+     * Lets the lacerator tear the springs past their limit on the state at time @p t
+     * (cut::Lacerator::check()); if it tore, emits system_changed. Requires
+     * lacerations.
+     */
+    cut::LacerationStatistics
+    lacerate(double t);
 
     /**
      * With multiresolution: re-extracts the level of detail if the focus at time @p t
      * (step @p step; with `Focus follows = tool` the cutter's blade) asks for it and, if
      * it changed, rebuilds the particle system on it with the particles' state carried
-     * over (Section 4.2), writing a line to @p out; the cutter, if any, restarts on it.
+     * over (Section 4.2), writing a line to @p out, and emits system_changed.
      * Postponed while a cut waits for its MT update (update_multiresolution_after_cut()).
      * Returns whether the particle system changed; without multiresolution, false.
      */
     bool
     update_level_of_detail(double t, unsigned int step, std::ostream &out);
-
-    /// What update_multiresolution_after_cut() did.
-    struct MultiresolutionCut
-    {
-      /// The MT update (SF, MT tetrahedra cut and created, MT-DAGUpd).
-      mt::MtCutter::Statistics update;
-      /// How the particles' state reached the MT's version of the cut level of detail.
-      mt::CutTransferReport transfer;
-      /// Connected pieces of the cutter's mesh before the switch and of the MT's
-      /// version after it (they differ where the MT update left a bridge).
-      unsigned int pieces_before = 0, pieces_after = 0;
-    };
 
     /**
      * With multiresolution: once the scalpel's stroke is over (its blade is in no
@@ -88,8 +126,8 @@ namespace lacerta::scene
      * of detail since the last call, updates the MT with their records, rebuilds the
      * particle system on the MT's version of the cut level of detail at time @p t (state
      * carried over by mt::transfer_state_across_cut(), masses scaled to ∫σ, constraints
-     * applied to the particles in their regions) and restarts the cutter on it. Returns
-     * what it did, or nothing if there was nothing to do.
+     * applied to the particles in their regions) and emits system_changed. Returns what
+     * it did, or nothing if there was nothing to do.
      */
     std::optional<MultiresolutionCut>
     update_multiresolution_after_cut(double t);
@@ -118,13 +156,6 @@ namespace lacerta::scene
     /// Recomputes the external forces at time @p t (only if some load varies).
     void
     update_loads(double t);
-
-    /**
-     * After a cut: the constraints take over the particles copied from theirs
-     * (@p copies, CutStepStatistics::copied_particles) and follow the new masses.
-     */
-    void
-    follow_cut(const std::vector<std::array<unsigned int, 2>> &copies);
 
     /// Writes a description of the scene (sizes, mass, stiffness range, constraints).
     void
@@ -164,15 +195,25 @@ namespace lacerta::scene
     /// The lacerator, only if `Laceration/Enabled` is true.
     std::unique_ptr<cut::Lacerator> lacerator;
 
+  private:
     /**
-     * After a tear changed the mesh under the scalpel: the cutter starts afresh at its
-     * blade (a stroke in progress restarts there), so that its search structures see
-     * the torn faces. Nothing without a cutter.
+     * The scene's own reaction to @p change, connected to system_changed first: after
+     * a cut or a tear the constraints take over the copies of their particles and
+     * follow the new masses; the lacerator learns of a cut; after a tear or a
+     * reassembly the cutter restarts, and after a reassembly the lacerator learns
+     * which particles the MT's cuts created.
+     */
+    void
+    follow_change(const SystemChange &change);
+
+    /**
+     * The cutter starts afresh on the mesh to cut at its blade (a stroke in progress
+     * restarts there), so that its search structures see what a tear or a new level
+     * of detail changed. Nothing without a cutter.
      */
     void
     restart_cutter();
 
-  private:
     /**
      * Sets the particle system up on @p active (the mesh or a level of detail) at time
      * @p t: masses (scaled to ∫σ over the mesh), springs, damping, body forces,
@@ -184,9 +225,8 @@ namespace lacerta::scene
     /**
      * Moves the particle system to the level of detail the MT now holds, at time @p t:
      * assembles it there, fills its positions and velocities with
-     * @p transfer(old_x, old_v, x, v) from the state it had, enforces the constraints,
-     * refreshes the force model, restarts the cutter on the new mesh and tells the
-     * lacerator, if any, that the particles changed (Lacerator::particles_replaced()).
+     * @p transfer(old_x, old_v, x, v) from the state it had, enforces the constraints
+     * and refreshes the force model.
      */
     template <typename Transfer>
     void

@@ -5,9 +5,11 @@
 #pragma once
 
 #include <lacerta/cut/tool.h>
+#include <lacerta/postprocess/postprocessor.h>
 
 #include <deal.II/base/parameter_handler.h>
 
+#include <chrono>
 #include <functional>
 #include <iosfwd>
 #include <memory>
@@ -15,20 +17,21 @@
 #include <string>
 #include <vector>
 
+namespace dealii
+{
+  class TimerOutput;
+}
 namespace lacerta::scene
 {
   class Scene;
-}
+  struct SystemChange;
+} // namespace lacerta::scene
 namespace lacerta::physics
 {
+  class BlowUpMonitor;
   class Integrator;
   class MassBalancer;
 } // namespace lacerta::physics
-namespace lacerta::postprocess
-{
-  class Postprocessor;
-  struct RunState;
-} // namespace lacerta::postprocess
 
 namespace lacerta
 {
@@ -100,6 +103,61 @@ namespace lacerta
     }
 
   private:
+    /// The phases of run(), in order. Before the first step: the scene's summary, the
+    /// stability limit, the postprocessors' step 0.
+    void
+    start_run();
+
+    /// Zeroes the state's columns that describe one step.
+    void
+    begin_step();
+
+    /// Moves the scalpel to where it is at the end of the step of length @p dt and
+    /// cuts (Scene::cut()).
+    void
+    move_tool(double dt);
+
+    /// Lets the springs past their limit tear (Scene::lacerate()).
+    void
+    lacerate(double dt);
+
+    /// Integrates the step of length @p dt in the chosen sub-steps.
+    void
+    integrate(double dt);
+
+    /// With multiresolution: the MT update after a stroke, then the level of detail
+    /// the focus asks for.
+    void
+    update_multiresolution();
+
+    /// Checks for blow-up where needed and calls the postprocessors and post_step.
+    void
+    postprocess();
+
+    /// The energies line ten times per run and the progress line on a terminal.
+    void
+    report_progress();
+
+    /// The end of the run: the summaries and, outside test mode, the timings.
+    void
+    finish_run();
+
+    /**
+     * The simulator's subscriber to Scene::system_changed: the mass redistribution,
+     * the invariants (after a local change), the integrator's scratch space, the
+     * blow-up monitor's ledger and the sub-steps start afresh on the changed system.
+     */
+    void
+    on_system_changed(const scene::SystemChange &change);
+
+    /// With `Check invariants`: stops the run naming @p at_step if one is broken.
+    void
+    check(unsigned int at_step) const;
+
+    /// The energies and the loads' work into the state.
+    void
+    evaluate_energies();
+
     /**
      * Checks the time step against the stability limit of the current state; returns
      * the sub-step count. @p current sub-steps, if given and still below the limit,
@@ -134,5 +192,27 @@ namespace lacerta
     /// 'Stability/Mass redistribution': keeps the time step after topology changes,
     /// or nullptr.
     std::unique_ptr<physics::MassBalancer> mass_balancer;
+
+    /// The run in progress: what the postprocessors see, the step, the time.
+    postprocess::RunState state;
+    unsigned int          step = 0, n_steps = 0, steps_done = 0;
+    double                time               = 0;
+    unsigned long long    n_integrator_steps = 0;
+    /// What this step's blade motion, tear and MT update did (state points into it).
+    struct StepResults;
+    std::unique_ptr<StepResults> step_results;
+    /// Mass redistribution over the run: the most mass held away from the lumped
+    /// masses at one change, the particles left above the target at the last one, and
+    /// the changes.
+    struct
+    {
+      double       largest_moved   = 0;
+      unsigned int last_unresolved = 0, n_balances = 0;
+    } redistribution;
+    std::unique_ptr<physics::BlowUpMonitor> monitor;
+    std::unique_ptr<dealii::TimerOutput>    timer;
+    std::chrono::steady_clock::time_point   run_start;
+    double                                  last_progress = 0;
+    bool                                    show_progress = false;
   };
 } // namespace lacerta

@@ -1,0 +1,54 @@
+/**
+ * @file
+ * The event "the particle system changed": what a cut, a tear or a new level of
+ * detail tells the rest of the program.
+ */
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace lacerta::scene
+{
+  /**
+   * A change of the particle system's topology: its particles, springs or masses are
+   * others than before. Scene::system_changed carries it to every subscriber.
+   */
+  struct SystemChange
+  {
+    /// What changed the system.
+    enum class Cause
+    {
+      /// The scalpel cut the mesh locally.
+      cut,
+      /// A tear cut the mesh locally.
+      laceration,
+      /// The system moved to the MT's version of the cut level of detail.
+      multiresolution_cut,
+      /// The system moved to a newly extracted level of detail.
+      level_of_detail
+    };
+
+    Cause cause;
+    /// Simulated time of the changed state (s).
+    double time = 0;
+    /**
+     * Particles a local cut duplicated along its surface, as (original, copy)
+     * (cut::CutStepStatistics::copied_particles); empty after a reassembly.
+     */
+    std::vector<std::array<unsigned int, 2>> copied_particles;
+
+    /// Whether the system was assembled anew on another mesh (every particle and
+    /// spring replaced) rather than changed locally.
+    bool
+    reassembled() const
+    {
+      return cause == Cause::multiresolution_cut || cause == Cause::level_of_detail;
+    }
+
+    /// The cause in words, for messages: "the cut", "the laceration", ...
+    std::string
+    describe() const;
+  };
+} // namespace lacerta::scene
