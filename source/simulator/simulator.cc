@@ -489,6 +489,8 @@ namespace lacerta
     state.over_limit = state.tears = state.torn_tets = state.tear_created_tets = 0;
     state.tear_seconds = state.mt_update_seconds = state.integration_seconds = 0;
     state.split_fragments                                                    = 0;
+    state.reextracted                                                        = false;
+    state.reextraction_seconds                                               = 0;
     *step_results = StepResults();
   }
 
@@ -559,7 +561,9 @@ namespace lacerta
       state.split_fragments   = mt_cut->update.split_fragments;
       state.mt_update_seconds = mt_cut->update.seconds;
     }
-    scene->update_level_of_detail(time, step, std::cout);
+    const auto start           = Clock::now();
+    state.reextracted          = scene->update_level_of_detail(time, step, std::cout);
+    state.reextraction_seconds = state.reextracted ? seconds_since(start) : 0.0;
     // The cutter is made anew on a new level of detail (Scene::system_changed).
     state.blade = scene->cutter ? &scene->cutter->blade() : nullptr;
   }

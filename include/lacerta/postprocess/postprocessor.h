@@ -72,6 +72,10 @@ namespace lacerta::postprocess
     double       mt_update_seconds = 0;
     /// Wall time of this step's integration (s).
     double integration_seconds = 0;
+    /// Whether the level of detail was re-extracted at the end of this step, and the
+    /// wall time of it (s; the move of the particle system included).
+    bool   reextracted          = false;
+    double reextraction_seconds = 0;
     /// The scene: its tool, cutter, lacerator and multiresolution model.
     const scene::Scene *scene = nullptr;
     /**
