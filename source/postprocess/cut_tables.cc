@@ -20,7 +20,9 @@ namespace lacerta::postprocess
      * goes, and at its end the paper's Table 1 (averages over the steps that cut: MS,
      * CuT, CrT, UpdT, RxT), Table 2's totals on a multiresolution model (SF, MT
      * tetrahedra cut and created, TetUp and MT-DAGUpd per stroke), the pieces' rest
-     * volumes and the laceration summary. In test mode no wall time is printed.
+     * volumes and the laceration summary. In test mode no wall time is printed. The
+     * lines of a change are printed when it happens (it subscribes to
+     * Scene::system_changed), so that they precede any error the change causes.
      */
     class CutTables : public Postprocessor
     {
@@ -37,34 +39,31 @@ namespace lacerta::postprocess
       }
 
       void
+      subscribe(scene::Scene &s) override
+      {
+        scene = &s;
+        s.system_changed.connect([this](const scene::SystemChange &change)
+                                 { report(change); });
+      }
+
+      void
       execute(const RunState &state) override
       {
-        if (state.cut_tets > 0)
-        {
-          ++table1.cutting_steps;
-          table1.cut += state.cut_tets;
-          table1.created += state.created_tets;
-          table1.update_seconds += state.update_seconds;
-          table1.relax_seconds += state.integration_seconds;
-        }
-        // Table 2 counts the cutter's work on the level of detail during a stroke,
-        // tears included (doc/lacerations.md).
-        stroke.cut += state.cut_tets + state.torn_tets;
-        stroke.created += state.created_tets + state.tear_created_tets;
-        stroke.update_seconds += state.update_seconds + state.tear_seconds;
-        if (state.tear)
-          report_tear(state, *state.tear);
-        if (state.mt_cut)
-          report_multiresolution_cut(state.time, *state.mt_cut);
+        if (state.cut_tets == 0)
+          return;
+        ++table1.cutting_steps;
+        table1.cut += state.cut_tets;
+        table1.created += state.created_tets;
+        table1.update_seconds += state.update_seconds;
+        table1.relax_seconds += state.integration_seconds;
       }
 
       void
       finish(const RunState &state) override
       {
-        const scene::Scene &scene = *state.scene;
-        if (scene.cutter)
-          print_table1(state);
-        if (scene.lacerator)
+        if (scene->cutter)
+          print_table1(*state.mesh);
+        if (scene->lacerator)
         {
           std::cout << "Laceration summary: " << tears.count << " tears, " << tears.cut
                     << " tetrahedra split into " << tears.created;
@@ -76,18 +75,37 @@ namespace lacerta::postprocess
       }
 
     private:
+      /// A change as it happens, before anything it causes: Table 2 counts the work
+      /// of the cutter and the tears on the level of detail during a stroke
+      /// (doc/lacerations.md), and the tears and MT updates get a line each.
       void
-      report_tear(const RunState &state, const cut::LacerationStatistics &tear)
+      report(const scene::SystemChange &change)
+      {
+        if (change.cut)
+        {
+          stroke.cut += change.cut->cut_tets;
+          stroke.created += change.cut->created_tets;
+          stroke.update_seconds += change.cut->update_seconds;
+        }
+        if (change.tear)
+        {
+          stroke.cut += change.tear->cut_tets;
+          stroke.created += change.tear->created_tets;
+          stroke.update_seconds += change.tear->update_seconds;
+          report_tear(change.time, *change.tear);
+        }
+        if (change.mt_cut)
+          report_multiresolution_cut(change.time, *change.mt_cut);
+      }
+
+      void
+      report_tear(const double time, const cut::LacerationStatistics &tear)
       {
         ++tears.count;
         tears.cut += tear.cut_tets;
         tears.created += tear.created_tets;
         tears.seconds += tear.update_seconds;
-        // The pieces of the mesh the tear cut: on a multiresolution model the MT update
-        // of the same step may have replaced it since.
-        const unsigned int pieces =
-          state.mt_cut ? state.mt_cut->pieces_before : cut::count_components(*state.mesh);
-        std::cout << "Laceration at t = " << state.time
+        std::cout << "Laceration at t = " << time
                   << " s: " << (tear.continued ? "continued" : "started")
                   << " at the spring " << tear.seed_a << "-" << tear.seed_b << " ("
                   << tear.seed_ratio << " times its maximum elongation, "
@@ -95,7 +113,7 @@ namespace lacerta::postprocess
                   << tear.advances << " advances, "
                   << (tear.complete ? "through" : "stopped inside") << "; "
                   << tear.cut_tets << " tetrahedra split into " << tear.created_tets
-                  << "; mesh components " << pieces;
+                  << "; mesh components " << cut::count_components(scene->active_mesh());
         if (!test_mode)
           std::cout << "; " << 1e3 * tear.update_seconds << " ms";
         std::cout << "\n";
@@ -129,37 +147,37 @@ namespace lacerta::postprocess
       }
 
       void
-      print_table1(const RunState &state) const
+      print_table1(const mesh::TetMesh &mesh) const
       {
-        const scene::Scene &scene = *state.scene;
-        const unsigned int  n     = table1.cutting_steps;
+        const unsigned int n = table1.cutting_steps;
         std::cout << "Cut summary (Table 1 columns, averages over the " << n
-                  << " steps that cut): MS " << state.mesh->n_tets() << ", CuT "
+                  << " steps that cut): MS " << mesh.n_tets() << ", CuT "
                   << (n ? table1.cut / n : 0.0) << ", CrT "
                   << (n ? table1.created / n : 0.0);
         if (!test_mode && n > 0)
           std::cout << ", UpdT " << 1e3 * table1.update_seconds / n << " ms, RxT "
                     << 1e3 * table1.relax_seconds / n << " ms";
-        if (scene.multiresolution)
+        if (scene->multiresolution)
           std::cout << "; " << table2.updates
                     << " MT updates (Table 2 columns: totals, times per stroke): SF "
                     << table2.split_fragments << ", MT tetrahedra cut " << table2.cut
                     << ", created " << table2.created
-                    << (scene.cut_pending() ? " (a stroke still waits for its update)"
-                                            : "");
+                    << (scene->cut_pending() ? " (a stroke still waits for its update)"
+                                             : "");
         if (!test_mode && table2.updates > 0)
           std::cout << ", TetUp " << 1e3 * table2.tet_update_seconds / table2.updates
                     << " ms, MT-DAGUpd "
                     << 1e3 * table2.mt_update_seconds / table2.updates << " ms";
         // The pieces' rest volumes show what a cut separated (a punched hole).
-        const std::vector<double> pieces = cut::component_volumes(*state.mesh);
+        const std::vector<double> pieces = cut::component_volumes(mesh);
         std::cout << "; mesh components " << pieces.size() << ", rest volumes (m^3)";
         for (const double v : pieces)
           std::cout << " " << v;
         std::cout << "\n";
       }
 
-      bool test_mode = false;
+      const scene::Scene *scene     = nullptr;
+      bool                test_mode = false;
       /// Table 1: the steps that cut, what they cut and created, and their times.
       struct
       {

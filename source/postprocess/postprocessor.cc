@@ -12,6 +12,12 @@ namespace lacerta::postprocess
   }
 
 
+  void
+  Postprocessor::subscribe(scene::Scene &)
+  {
+  }
+
+
   bool
   Postprocessor::needs_energies(double) const
   {

@@ -117,7 +117,7 @@ namespace lacerta::scene
   {
     if (!change.reassembled())
       for (auto &constraint : constraints)
-        constraint->follow_copies(change.copied_particles, *system);
+        constraint->follow_copies(change.copied_particles(), *system);
     if (change.cause == SystemChange::Cause::cut && lacerator)
       lacerator->mesh_changed();
     if (change.cause != SystemChange::Cause::cut)
@@ -143,8 +143,11 @@ namespace lacerta::scene
       throw_error("Scene::cut(): the scene has no tool.");
     cut::CutStepStatistics statistics = cutter->move_blade(blade);
     if (statistics.changed)
-      system_changed(
-        SystemChange{SystemChange::Cause::cut, t, statistics.copied_particles});
+    {
+      SystemChange change{SystemChange::Cause::cut, t};
+      change.cut = &statistics;
+      system_changed(change);
+    }
     return statistics;
   }
 
@@ -156,8 +159,11 @@ namespace lacerta::scene
       throw_error("Scene::lacerate(): the scene has no lacerations.");
     cut::LacerationStatistics statistics = lacerator->check();
     if (statistics.changed)
-      system_changed(
-        SystemChange{SystemChange::Cause::laceration, t, statistics.copied_particles});
+    {
+      SystemChange change{SystemChange::Cause::laceration, t};
+      change.tear = &statistics;
+      system_changed(change);
+    }
     return statistics;
   }
 
@@ -227,7 +233,9 @@ namespace lacerta::scene
     result.n_tets       = active_mesh().n_tets();
     result.n_particles  = system->n_particles();
     result.mass         = std::accumulate(system->mass.begin(), system->mass.end(), 0.0);
-    system_changed(SystemChange{SystemChange::Cause::multiresolution_cut, t, {}});
+    SystemChange change{SystemChange::Cause::multiresolution_cut, t};
+    change.mt_cut = &result;
+    system_changed(change);
     return result;
   }
 
@@ -325,7 +333,7 @@ namespace lacerta::scene
       { multiresolution->transfer_state(old_vertices, old_x, old_v, x, v); });
     multiresolution->print_change(
       out, t, std::accumulate(system->mass.begin(), system->mass.end(), 0.0));
-    system_changed(SystemChange{SystemChange::Cause::level_of_detail, t, {}});
+    system_changed(SystemChange{SystemChange::Cause::level_of_detail, t});
     return true;
   }
 
@@ -368,6 +376,14 @@ namespace lacerta::scene
           << " particles, "
           << (constraint->prescribes_motion() ? "prescribed motion" : "applied force")
           << "\n";
+  }
+
+
+  const std::vector<std::array<unsigned int, 2>> &
+  SystemChange::copied_particles() const
+  {
+    static const std::vector<std::array<unsigned int, 2>> none;
+    return cut ? cut->copied_particles : tear ? tear->copied_particles : none;
   }
 
 

@@ -293,9 +293,8 @@ namespace lacerta
     prm.print_parameters(copy, dealii::ParameterHandler::ShortPRM);
     write_file_atomically(output_directory + "/parameters.prm", copy.str());
 
-    scene        = std::make_unique<scene::Scene>(prm, n_threads);
-    step_results = std::make_unique<StepResults>();
-    integrator   = physics::Integrator::create(prm);
+    scene      = std::make_unique<scene::Scene>(prm, n_threads);
+    integrator = physics::Integrator::create(prm);
     // A scene that cuts or tears always prints the paper's tables.
     postprocessors =
       postprocess::Postprocessor::create(prm,
@@ -307,18 +306,13 @@ namespace lacerta
         std::make_unique<physics::MassBalancer>(*scene->system, redistribution_reach);
     integrator->initialize(*scene->system);
     for (auto &p : postprocessors)
+    {
       p->initialize(output_directory, test_mode);
+      p->subscribe(*scene);
+    }
     scene->system_changed.connect([this](const scene::SystemChange &change)
                                   { on_system_changed(change); });
   }
-
-
-  struct Simulator::StepResults
-  {
-    std::optional<cut::CutStepStatistics>    cut;
-    std::optional<cut::LacerationStatistics> tear;
-    std::optional<scene::MultiresolutionCut> mt_cut;
-  };
 
 
   Simulator::~Simulator() = default;
@@ -423,7 +417,7 @@ namespace lacerta
       if (scene->cutter)
         move_tool(dt);
       if (scene->lacerator)
-        lacerate(dt);
+        lacerate();
       integrate(dt);
       time = (step == n_steps) ? end_time : time + dt;
       update_multiresolution();
@@ -461,7 +455,6 @@ namespace lacerta
     state.mesh     = &scene->active_mesh();
     state.system   = &system;
     state.material = &scene->material;
-    state.scene    = scene.get();
     state.blade    = scene->cutter ? &scene->cutter->blade() : nullptr;
     step           = 0;
     time           = 0;
@@ -481,9 +474,6 @@ namespace lacerta
   {
     // This step's columns start at zero; what the run carries (the mesh, the blade, the
     // sub-steps, the energies last evaluated) stays.
-    state.cut      = nullptr;
-    state.tear     = nullptr;
-    state.mt_cut   = nullptr;
     state.cut_tets = state.created_tets = 0;
     state.update_seconds = state.cut_step_seconds = 0;
     state.over_limit = state.tears = state.torn_tets = state.tear_created_tets = 0;
@@ -491,7 +481,6 @@ namespace lacerta
     state.split_fragments                                                    = 0;
     state.reextracted                                                        = false;
     state.reextraction_seconds                                               = 0;
-    *step_results = StepResults();
   }
 
 
@@ -502,31 +491,27 @@ namespace lacerta
     std::optional<cut::Blade>  blade;
     if (signals.blade)
       blade = signals.blade(time + dt);
-    auto &cut          = step_results->cut;
-    cut                = scene->cut(blade ? *blade : scene->tool->blade(time + dt), time);
-    state.cut          = &*cut;
-    state.cut_tets     = cut->cut_tets;
-    state.created_tets = cut->created_tets;
-    state.update_seconds = cut->update_seconds;
-    state.cut_step_seconds =
-      cut->search_seconds + cut->update_seconds + cut->reinit_seconds;
+    const cut::CutStepStatistics cut =
+      scene->cut(blade ? *blade : scene->tool->blade(time + dt), time);
+    state.cut_tets         = cut.cut_tets;
+    state.created_tets     = cut.created_tets;
+    state.update_seconds   = cut.update_seconds;
+    state.cut_step_seconds = cut.search_seconds + cut.update_seconds + cut.reinit_seconds;
   }
 
 
   void
-  Simulator::lacerate(const double)
+  Simulator::lacerate()
   {
-    dealii::TimerOutput::Scope scope(*timer, "laceration");
-    auto                      &tear = step_results->tear;
-    tear                            = scene->lacerate(time);
-    state.over_limit                = tear->over_limit;
-    if (!tear->changed)
+    dealii::TimerOutput::Scope      scope(*timer, "laceration");
+    const cut::LacerationStatistics tear = scene->lacerate(time);
+    state.over_limit                     = tear.over_limit;
+    if (!tear.changed)
       return;
-    state.tear              = &*tear;
     state.tears             = 1;
-    state.torn_tets         = tear->cut_tets;
-    state.tear_created_tets = tear->created_tets;
-    state.tear_seconds      = tear->update_seconds;
+    state.torn_tets         = tear.cut_tets;
+    state.tear_created_tets = tear.created_tets;
+    state.tear_seconds      = tear.update_seconds;
   }
 
 
@@ -554,10 +539,8 @@ namespace lacerta
   {
     if (!scene->multiresolution)
       return;
-    auto &mt_cut = step_results->mt_cut;
-    if ((mt_cut = scene->update_multiresolution_after_cut(time)))
+    if (const auto mt_cut = scene->update_multiresolution_after_cut(time))
     {
-      state.mt_cut            = &*mt_cut;
       state.split_fragments   = mt_cut->update.split_fragments;
       state.mt_update_seconds = mt_cut->update.seconds;
     }

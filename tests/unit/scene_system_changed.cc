@@ -55,13 +55,19 @@ namespace lacerta
       [&](const scene::SystemChange &c)
       {
         heard.push_back(
-          {c.cause, c.time, c.copied_particles.size(), scene->system->n_particles()});
+          {c.cause, c.time, c.copied_particles().size(), scene->system->n_particles()});
         // The scene's own subscriber ran first: the cutter works on the current mesh.
         ASSERT_TRUE(scene->cutter);
         EXPECT_EQ(c.reassembled(),
                   c.cause == Cause::multiresolution_cut
                     || c.cause == Cause::level_of_detail);
         EXPECT_FALSE(c.describe().empty());
+        // What the change did comes with it, for its cause only.
+        EXPECT_EQ(c.cut != nullptr, c.cause == Cause::cut);
+        EXPECT_EQ(c.tear != nullptr, c.cause == Cause::laceration);
+        EXPECT_EQ(c.mt_cut != nullptr, c.cause == Cause::multiresolution_cut);
+        if (c.mt_cut)
+          EXPECT_EQ(c.mt_cut->n_tets, scene->active_mesh().n_tets());
       });
     const unsigned int n_steps = 60;
     unsigned int       changes = 0;

@@ -22,14 +22,11 @@ namespace lacerta::scene
 {
   class Material;
   class Scene;
-  struct MultiresolutionCut;
 } // namespace lacerta::scene
 namespace lacerta::cut
 {
   struct Blade;
-  struct CutStepStatistics;
-  struct LacerationStatistics;
-} // namespace lacerta::cut
+}
 
 namespace lacerta::postprocess
 {
@@ -76,15 +73,6 @@ namespace lacerta::postprocess
     /// wall time of it (s; the move of the particle system included).
     bool   reextracted          = false;
     double reextraction_seconds = 0;
-    /// The scene: its tool, cutter, lacerator and multiresolution model.
-    const scene::Scene *scene = nullptr;
-    /**
-     * What this step's blade motion, tear and MT update after a stroke did in full, or
-     * nullptr where the step had none; valid during execute() only.
-     */
-    const cut::CutStepStatistics    *cut    = nullptr;
-    const cut::LacerationStatistics *tear   = nullptr;
-    const scene::MultiresolutionCut *mt_cut = nullptr;
   };
 
 
@@ -113,6 +101,15 @@ namespace lacerta::postprocess
      */
     virtual void
     initialize(const std::string &output_directory, bool test_mode) = 0;
+
+    /**
+     * Connects to the events of @p scene (Scene::system_changed) if the postprocessor
+     * reports them as they happen; by default it does not. Called once, after
+     * initialize() and before the simulator's own subscriber, so that what it prints
+     * of a change comes before any error the change causes.
+     */
+    virtual void
+    subscribe(scene::Scene &scene);
 
     /// Whether execute() at time @p time needs the energies of the state.
     virtual bool

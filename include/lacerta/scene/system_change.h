@@ -9,8 +9,16 @@
 #include <string>
 #include <vector>
 
+namespace lacerta::cut
+{
+  struct CutStepStatistics;
+  struct LacerationStatistics;
+} // namespace lacerta::cut
+
 namespace lacerta::scene
 {
+  struct MultiresolutionCut;
+
   /**
    * A change of the particle system's topology: its particles, springs or masses are
    * others than before. Scene::system_changed carries it to every subscriber.
@@ -34,10 +42,18 @@ namespace lacerta::scene
     /// Simulated time of the changed state (s).
     double time = 0;
     /**
-     * Particles a local cut duplicated along its surface, as (original, copy)
-     * (cut::CutStepStatistics::copied_particles); empty after a reassembly.
+     * What the change did: the blade motion's statistics for a cut, the tear's for a
+     * laceration, the MT update's for a multiresolution cut; nullptr otherwise. Valid
+     * during the event only.
      */
-    std::vector<std::array<unsigned int, 2>> copied_particles;
+    const cut::CutStepStatistics    *cut    = nullptr;
+    const cut::LacerationStatistics *tear   = nullptr;
+    const MultiresolutionCut        *mt_cut = nullptr;
+
+    /// Particles a local cut or tear duplicated along its surface, as (original, copy)
+    /// (cut::CutStepStatistics::copied_particles); empty after a reassembly.
+    const std::vector<std::array<unsigned int, 2>> &
+    copied_particles() const;
 
     /// Whether the system was assembled anew on another mesh (every particle and
     /// spring replaced) rather than changed locally.

@@ -119,7 +119,7 @@ namespace lacerta
 
     /// Lets the springs past their limit tear (Scene::lacerate()).
     void
-    lacerate(double dt);
+    lacerate();
 
     /// Integrates the step of length @p dt in the chosen sub-steps.
     void
@@ -198,9 +198,6 @@ namespace lacerta
     unsigned int          step = 0, n_steps = 0, steps_done = 0;
     double                time               = 0;
     unsigned long long    n_integrator_steps = 0;
-    /// What this step's blade motion, tear and MT update did (state points into it).
-    struct StepResults;
-    std::unique_ptr<StepResults> step_results;
     /// Mass redistribution over the run: the most mass held away from the lumped
     /// masses at one change, the particles left above the target at the last one, and
     /// the changes.
