@@ -1,6 +1,7 @@
 // lacerta-bench mt: Multi-Triangulation build time and memory, extraction time from
 // scratch and incremental. lacerta-bench lod: LOD simulation error against run time.
 
+#include <lacerta/fem/spring_statics.h>
 #include <lacerta/mesh/triangulation_conversion.h>
 #include <lacerta/mt/builder.h>
 #include <lacerta/mt/lod.h>
@@ -195,11 +196,35 @@ namespace lacerta::bench
 
 
     /**
+     * The lowest @p n eigenfrequencies (Hz) of the springs, linearised at rest, of the
+     * scene @p file with @p settings at its start: the full mesh or the first level of
+     * detail (the material a level of detail stands for, issue 17 item 2).
+     */
+    std::vector<double>
+    lowest_frequencies(const std::string &file,
+                       const std::string &settings,
+                       const unsigned int n)
+    {
+      dealii::ParameterHandler prm;
+      Simulator::read_parameters(file, prm);
+      std::istringstream extra(settings);
+      prm.parse_input(extra, "benchmark settings", "", true);
+      prm.enter_subsection("Multiresolution");
+      prm.set("Cache directory", "");
+      prm.leave_subsection();
+      const scene::Scene scene(prm, 1);
+      return fem::spring_frequencies(*scene.system, n);
+    }
+
+
+    /**
      * The LOD speed-up against accuracy: a scene (default prm/square_lod.prm) run to
      * its end time (default 0.5 s) at full resolution and on levels of detail of
      * several growths; for each, the wall time and the displacement error at the
      * particles the LOD keeps, against the full resolution (largest and RMS, relative
-     * to the largest displacement), as `lod.<variant>.<figure>`.
+     * to the largest displacement), as `lod.<variant>.<figure>`; and the lowest four
+     * eigenfrequencies of the full mesh and of each first level of detail, with their
+     * ratio to the full mesh's (`frequency_ratio_<i>`).
      */
     int
     run_lod(const std::vector<std::string> &arguments)
@@ -218,16 +243,22 @@ namespace lacerta::bench
                            std::hypot(full.position[i] - full.rest[i],
                                       full.position[i + 1] - full.rest[i + 1],
                                       full.position[i + 2] - full.rest[i + 2]));
+      const unsigned int n_modes = 4;
+      const std::string  full_settings =
+        "subsection Multiresolution\n set Enabled = false\nend\n";
+      const std::vector<double> full_modes =
+        lowest_frequencies(file, full_settings, n_modes);
+      for (unsigned int i = 0; i < n_modes; ++i)
+        print_figure("lod.full.frequency_" + std::to_string(i), full_modes[i], "Hz");
       print_figure("lod.full.tetrahedra", full.tets, "");
       print_figure("lod.full.wall_time", full.seconds, "s");
       print_figure("lod.full.largest_displacement", largest, "m");
       for (const std::string growth : {"0.25", "0.5", "1", "2"})
       {
-        const Run lod   = simulate(file,
-                                 end_time,
-                                 "subsection Multiresolution\n set Enabled = true\n"
-                                   " subsection Focus\n  set Cell size growth = "
-                                   + growth + "\n end\nend\n");
+        const std::string settings = "subsection Multiresolution\n set Enabled = true\n"
+                                     " subsection Focus\n  set Cell size growth = "
+                                     + growth + "\n end\nend\n";
+        const Run lod   = simulate(file, end_time, settings);
         double    worst = 0, squares = 0;
         for (std::size_t i = 0; i < lod.vertices.size(); ++i)
         {
@@ -246,6 +277,11 @@ namespace lacerta::bench
         print_figure(prefix + "rms_error",
                      std::sqrt(squares / lod.vertices.size()) / largest,
                      "");
+        const std::vector<double> modes = lowest_frequencies(file, settings, n_modes);
+        for (unsigned int i = 0; i < n_modes; ++i)
+          print_figure(prefix + "frequency_ratio_" + std::to_string(i),
+                       modes[i] / full_modes[i],
+                       "");
         // Issue 17's target: a re-extraction costs less than 5 steps of the LOD.
         print_figure(prefix + "reextractions", lod.reextractions, "");
         print_figure(prefix + "reextraction_cost", 1e3 * lod.reextraction_seconds, "ms");
