@@ -547,8 +547,6 @@ namespace lacerta
     const auto start           = Clock::now();
     state.reextracted          = scene->update_level_of_detail(time, step, std::cout);
     state.reextraction_seconds = state.reextracted ? seconds_since(start) : 0.0;
-    // The cutter is made anew on a new level of detail (Scene::system_changed).
-    state.blade = scene->cutter ? &scene->cutter->blade() : nullptr;
   }
 
 
