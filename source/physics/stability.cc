@@ -118,7 +118,10 @@ namespace lacerta::physics
   {
     const unsigned int n       = system.n_particles();
     const SpringSet   &springs = system.springs;
-    const double       scale   = system.force_model().spring_stiffness_scale();
+    // A system without a force model yet (a bare spring network) is bounded by its
+    // springs as they are.
+    const double scale =
+      system.has_force_model() ? system.force_model().spring_stiffness_scale() : 1.0;
     std::vector<std::array<double, 6>> blocks(n, std::array<double, 6>{});
     std::vector<double>                pair_norm(springs.size(), 0.0);
     GershgorinTerms                    terms;
@@ -148,7 +151,8 @@ namespace lacerta::physics
       add_block(blocks[i], block);
       add_block(blocks[j], block);
     }
-    add_element_terms(system, x, blocks, pair_norm);
+    if (system.has_force_model())
+      add_element_terms(system, x, blocks, pair_norm);
 
     std::vector<double> stiffest(n, 0.0);
     for (std::size_t s = 0; s < springs.size(); ++s)

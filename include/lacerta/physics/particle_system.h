@@ -149,6 +149,13 @@ namespace lacerta::physics
                  const std::array<double, 3> &x,
                  const std::array<double, 3> &v);
 
+    /// Whether a force model was set (set_force_model()).
+    bool
+    has_force_model() const
+    {
+      return forces != nullptr;
+    }
+
     /// The force model.
     const ForceModel &
     force_model() const

@@ -48,6 +48,7 @@ namespace lacerta::physics
    * plus the per-tetrahedron stiffness of the force model if it has one
    * (ForceModel::for_each_element_stiffness()): the diagonal blocks of each element
    * stiffness, and the norm of each off-diagonal block added to the spring of its edge.
+   * A system without a force model is bounded by its springs as they are.
    */
   GershgorinTerms
   gershgorin_terms(const ParticleSystem &system, const double *positions);
