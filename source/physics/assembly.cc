@@ -225,39 +225,44 @@ namespace lacerta::physics
     }
 
 
-    /**
-     * The 12x12 stiffness matrix of a linear (P1) tetrahedron with Lamé parameters
-     * λ, μ, rows and columns ordered (vertex, component).
-     */
-    dealii::FullMatrix<double>
-    p1_element_stiffness(const std::array<mesh::Point3, 4> &x,
-                         const double                       lambda,
-                         const double                       mu)
-    {
-      dealii::Tensor<2, 3> jacobian;
-      for (unsigned int i = 0; i < 3; ++i)
-        for (unsigned int d = 0; d < 3; ++d)
-          jacobian[d][i] = x[i + 1][d] - x[0][d];
-      const double               volume  = std::abs(dealii::determinant(jacobian)) / 6;
-      const dealii::Tensor<2, 3> inverse = dealii::invert(jacobian);
-      // Gradients of the barycentric coordinates: rows of J⁻¹ for vertices 1..3.
-      std::array<dealii::Tensor<1, 3>, 4> g;
-      for (unsigned int i = 0; i < 3; ++i)
-        for (unsigned int d = 0; d < 3; ++d)
-          g[i + 1][d] = inverse[i][d];
-      g[0] = -(g[1] + g[2] + g[3]);
-      dealii::FullMatrix<double> k(12, 12);
-      for (unsigned int i = 0; i < 4; ++i)
-        for (unsigned int j = 0; j < 4; ++j)
-          for (unsigned int c = 0; c < 3; ++c)
-            for (unsigned int d = 0; d < 3; ++d)
-              k(3 * i + c, 3 * j + d) =
-                volume
-                * (lambda * g[i][c] * g[j][d] + mu * g[i][d] * g[j][c]
-                   + (c == d ? mu * (g[i] * g[j]) : 0.0));
-      return k;
-    }
   } // namespace
+
+
+  std::array<double, 2>
+  lame_parameters(const double youngs, const double nu)
+  {
+    return {{youngs * nu / ((1 + nu) * (1 - 2 * nu)), youngs / (2 * (1 + nu))}};
+  }
+
+
+  dealii::FullMatrix<double>
+  p1_element_stiffness(const std::array<mesh::Point3, 4> &x,
+                       const double                       lambda,
+                       const double                       mu)
+  {
+    dealii::Tensor<2, 3> jacobian;
+    for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int d = 0; d < 3; ++d)
+        jacobian[d][i] = x[i + 1][d] - x[0][d];
+    const double               volume  = std::abs(dealii::determinant(jacobian)) / 6;
+    const dealii::Tensor<2, 3> inverse = dealii::invert(jacobian);
+    // Gradients of the barycentric coordinates: rows of J⁻¹ for vertices 1..3.
+    std::array<dealii::Tensor<1, 3>, 4> g;
+    for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int d = 0; d < 3; ++d)
+        g[i + 1][d] = inverse[i][d];
+    g[0] = -(g[1] + g[2] + g[3]);
+    dealii::FullMatrix<double> k(12, 12);
+    for (unsigned int i = 0; i < 4; ++i)
+      for (unsigned int j = 0; j < 4; ++j)
+        for (unsigned int c = 0; c < 3; ++c)
+          for (unsigned int d = 0; d < 3; ++d)
+            k(3 * i + c, 3 * j + d) =
+              volume
+              * (lambda * g[i][c] * g[j][d] + mu * g[i][d] * g[j][c]
+                 + (c == d ? mu * (g[i] * g[j]) : 0.0));
+    return k;
+  }
 
 
   double
@@ -319,10 +324,9 @@ namespace lacerta::physics
         std::array<mesh::Point3, 4> x;
         for (unsigned int i = 0; i < 4; ++i)
           x[i] = mesh.vertex(mesh.tet(t)[i]);
-        const double E  = youngs_modulus.value(centroid_of(mesh, t));
-        const double nu = poisson_ratio;
-        const auto   target =
-          p1_element_stiffness(x, E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu)));
+        const double E          = youngs_modulus.value(centroid_of(mesh, t));
+        const auto [lambda, mu] = lame_parameters(E, poisson_ratio);
+        const auto target       = p1_element_stiffness(x, lambda, mu);
         // The stiffness of a unit spring on each local edge: k n nᵀ blocks.
         std::array<dealii::FullMatrix<double>, 6> unit;
         for (unsigned int e = 0; e < 6; ++e)

@@ -8,6 +8,22 @@ namespace lacerta::physics
   }
 
 
+  double
+  ForceModel::spring_stiffness_scale() const
+  {
+    return 1.0;
+  }
+
+
+  void
+  ForceModel::for_each_element_stiffness(
+    const ParticleSystem &,
+    const double *,
+    const std::function<void(unsigned int, const ElementStiffness &)> &) const
+  {
+  }
+
+
   void
   ForceModel::declare_parameters(dealii::ParameterHandler &prm)
   {
@@ -16,7 +32,10 @@ namespace lacerta::physics
       "Force model",
       "Model",
       "linear springs",
-      "How the springs turn elongation into force.");
+      "How the particles' positions turn into elastic forces: the paper's "
+      "springs, springs with a volume term per tetrahedron that reproduce "
+      "'Material/Poisson ratio', or corotated linear FEM on the tetrahedra "
+      "(doc/physics.md; doc/manual.md says how to choose).");
   }
 
 

@@ -1,4 +1,5 @@
 #include <lacerta/base/exceptions.h>
+#include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/force_model.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/stability.h>
@@ -54,13 +55,75 @@ namespace lacerta::physics
   } // namespace
 
 
+  namespace
+  {
+    /// Adds the symmetric 3x3 block @p b (xx, yy, zz, xy, xz, yz) to @p sum.
+    void
+    add_block(std::array<double, 6> &sum, const std::array<double, 6> &b)
+    {
+      for (unsigned int c = 0; c < 6; ++c)
+        sum[c] += b[c];
+    }
+
+
+    /**
+     * Adds the terms of the force model's per-tetrahedron stiffness (if it has any) to
+     * the diagonal @p blocks and to the @p pair_norm of every spring (mesh edge): the
+     * diagonal blocks of each element stiffness, and the spectral norm of each
+     * off-diagonal block to the spring of its edge.
+     */
+    void
+    add_element_terms(const ParticleSystem               &system,
+                      const double                       *x,
+                      std::vector<std::array<double, 6>> &blocks,
+                      std::vector<double>                &pair_norm)
+    {
+      system.force_model().for_each_element_stiffness(
+        system,
+        x,
+        [&](const unsigned int t, const ForceModel::ElementStiffness &K)
+        {
+          const mesh::Tet &tet = system.mesh->tet(t);
+          const auto       at =
+            [&](unsigned int a, unsigned int r, unsigned int b, unsigned int c)
+          { return K[12 * (3 * a + r) + 3 * b + c]; };
+          for (unsigned int a = 0; a < 4; ++a)
+            add_block(blocks[tet[a]],
+                      {at(a, 0, a, 0),
+                       at(a, 1, a, 1),
+                       at(a, 2, a, 2),
+                       0.5 * (at(a, 0, a, 1) + at(a, 1, a, 0)),
+                       0.5 * (at(a, 0, a, 2) + at(a, 2, a, 0)),
+                       0.5 * (at(a, 1, a, 2) + at(a, 2, a, 1))});
+          for (unsigned int e = 0; e < 6; ++e)
+          {
+            const auto [a, b] = mesh::TetMesh::edge_vertices[e];
+            // ||K_ab||² = λ_max(K_abᵀ K_ab).
+            std::array<double, 6> gram{};
+            const unsigned int    pairs[6][2] = {
+                 {0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+            for (unsigned int g = 0; g < 6; ++g)
+              for (unsigned int r = 0; r < 3; ++r)
+                gram[g] += at(a, r, b, pairs[g][0]) * at(a, r, b, pairs[g][1]);
+            pair_norm[system.mesh->tet_edges(t)[e]] +=
+              std::sqrt(std::max(0.0, largest_eigenvalue(gram)));
+          }
+        });
+    }
+  } // namespace
+
+
   GershgorinTerms
   gershgorin_terms(const ParticleSystem &system, const double *x)
   {
-    const unsigned int                 n       = system.n_particles();
-    const SpringSet                   &springs = system.springs;
+    const unsigned int n       = system.n_particles();
+    const SpringSet   &springs = system.springs;
+    // A system without a force model yet (a bare spring network) is bounded by its
+    // springs as they are.
+    const double scale =
+      system.has_force_model() ? system.force_model().spring_stiffness_scale() : 1.0;
     std::vector<std::array<double, 6>> blocks(n, std::array<double, 6>{});
-    std::vector<double>                stiffest(n, 0.0);
+    std::vector<double>                pair_norm(springs.size(), 0.0);
     GershgorinTerms                    terms;
     terms.diagonal.assign(n, 0.0);
     terms.coupling.assign(springs.size(), 0.0);
@@ -75,7 +138,7 @@ namespace lacerta::physics
       const double       length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
       for (double &c : d)
         c /= length;
-      const double k         = springs.stiffness[s];
+      const double k         = scale * springs.stiffness[s];
       const double geometric = k * (1.0 - springs.rest_length[s] / length);
       // K_e = (k - g) n nᵀ + g I, g the geometric stiffness.
       const std::array<double, 6> block = {(k - geometric) * d[0] * d[0] + geometric,
@@ -84,19 +147,25 @@ namespace lacerta::physics
                                            (k - geometric) * d[0] * d[1],
                                            (k - geometric) * d[0] * d[2],
                                            (k - geometric) * d[1] * d[2]};
-      const double                norm  = std::max(k, std::abs(geometric));
+      pair_norm[s]                      = std::max(k, std::abs(geometric));
+      add_block(blocks[i], block);
+      add_block(blocks[j], block);
+    }
+    if (system.has_force_model())
+      add_element_terms(system, x, blocks, pair_norm);
+
+    std::vector<double> stiffest(n, 0.0);
+    for (std::size_t s = 0; s < springs.size(); ++s)
+    {
+      const unsigned int i = springs.a[s], j = springs.b[s];
       if (system.free[i] > 0 && system.free[j] > 0)
-        terms.coupling[s] = norm;
+        terms.coupling[s] = pair_norm[s];
       for (const unsigned int p : {i, j})
-      {
-        for (unsigned int c = 0; c < 6; ++c)
-          blocks[p][c] += block[c];
-        if (norm > stiffest[p])
+        if (pair_norm[s] > stiffest[p])
         {
-          stiffest[p]              = norm;
+          stiffest[p]              = pair_norm[s];
           terms.stiffest_spring[p] = s;
         }
-      }
     }
     for (unsigned int i = 0; i < n; ++i)
       terms.diagonal[i] = largest_eigenvalue(blocks[i]);

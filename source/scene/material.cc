@@ -72,9 +72,9 @@ namespace lacerta::scene
       "Poisson ratio",
       "0.25",
       dealii::Patterns::Double(0.0, 0.499),
-      "Poisson ratio of the FEM reference and of the fitted springs. The "
-      "paper's springs contract with their own effective ratio whatever is "
-      "asked here (doc/accuracy.md).");
+      "Poisson ratio of the FEM reference, of the fitted springs and of the force "
+      "models 'volume springs' and 'corotated fem'. The paper's springs contract "
+      "with their own effective ratio whatever is asked here (doc/accuracy.md).");
     prm.declare_entry(
       "Spring stiffness",
       "paper",

@@ -72,11 +72,17 @@ namespace lacerta::scene
       // The full mesh's stability, to set the level of detail's against (issue 17):
       // assembled once, then replaced by the level of detail.
       assemble(mesh, 0.0);
+      system->set_force_model(physics::ForceModel::create(prm), n_threads);
       full_mesh_stability.omega = physics::bound_highest_frequency(*system).omega;
       full_mesh_stability.multirate_share = physics::multirate_evaluation_share(*system);
+      assemble(active_mesh(), 0.0);
+      system->update_force_model(n_threads);
     }
-    assemble(active_mesh(), 0.0);
-    system->set_force_model(physics::ForceModel::create(prm), n_threads);
+    else
+    {
+      assemble(active_mesh(), 0.0);
+      system->set_force_model(physics::ForceModel::create(prm), n_threads);
+    }
     initial_volume    = mesh.total_volume();
     cutter_parameters = cut::Cutter::parse_parameters(prm);
     if (tool)
@@ -296,6 +302,9 @@ namespace lacerta::scene
                     " N/m; Young's modulus must be positive and finite on the object.");
     system->mass_damping   = material.mass_damping;
     system->spring_damping = material.spring_damping;
+    system->mesh           = &active;
+    system->youngs_modulus = &material.youngs_modulus();
+    system->poisson_ratio  = material.poisson_ratio;
     for (auto &force : body_forces)
       force->initialize(*system);
     for (auto &constraint : constraints)

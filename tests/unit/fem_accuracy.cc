@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "pulled_bar.h"
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -291,59 +292,10 @@ namespace
   }
 } // namespace
 
+
 namespace
 {
-  /// The lateral contraction ν_eff = -ε_yy / ε_xx in the middle of a bar clamped at
-  /// x = 0 and pulled at x = L, from the displacement @p u of the vertices.
-  double
-  effective_poisson_ratio(const mesh::TetMesh &mesh, const std::vector<double> &u)
-  {
-    // Least-squares slopes of u_x over x and of u_y over y in the middle fifth.
-    double sxx = 0, sx = 0, sux = 0, sxu = 0, syy = 0, sy = 0, suy = 0, syu = 0;
-    int    n = 0;
-    for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
-    {
-      const auto &x = mesh.vertex(v);
-      if (x[0] < 0.08 || x[0] > 0.12)
-        continue;
-      sxx += x[0] * x[0];
-      sx += x[0];
-      sux += u[3 * v];
-      sxu += x[0] * u[3 * v];
-      syy += x[1] * x[1];
-      sy += x[1];
-      suy += u[3 * v + 1];
-      syu += x[1] * u[3 * v + 1];
-      ++n;
-    }
-    const double exx = (n * sxu - sx * sux) / (n * sxx - sx * sx);
-    const double eyy = (n * syu - sy * suy) / (n * syy - sy * sy);
-    return -eyy / exx;
-  }
-
-  /// A bar 0.2 x 0.02 x 0.02 m, clamped at x = 0, pulled by 1 N at x = L.
-  std::unique_ptr<scene::Scene>
-  pulled_bar(const std::string &poisson, const std::string &stiffness)
-  {
-    // The pulling constraint is a named instance: it must be in the file to exist.
-    const std::string file = "pulled_bar.prm";
-    std::ofstream(file) << "include " << scenes << "cantilever.prm\n"
-                        << "subsection Mesh\n subsection Box\n"
-                        << "  set Upper corner = 0.2, 0.02, 0.02\n"
-                        << "  set Repetitions = 20, 2, 2\n end\nend\n"
-                        << "subsection Body forces\n set List of body forces =\nend\n"
-                        << "subsection Material\n set Poisson ratio = " << poisson
-                        << "\n set Spring stiffness = " << stiffness << "\nend\n"
-                        << "subsection Constraints\n set Names = clamp, pull\n"
-                        << " subsection pull\n  set Type = force handle\n"
-                        << "  set Region = boundary id\n"
-                        << "  subsection Boundary id\n   set Boundary ids = 1\n  end\n"
-                        << "  subsection Force handle\n   set Force = 1; 0; 0\n  end\n"
-                        << " end\nend\n";
-    dealii::ParameterHandler prm;
-    Simulator::read_parameters(file, prm);
-    return std::make_unique<scene::Scene>(prm, 1);
-  }
+  using namespace lacerta;
 
   /// FEM shows the Poisson ratio it is given; the springs show one of their lattice's
   /// own, whatever is asked (doc/accuracy.md, "What ν means for springs").
@@ -352,18 +304,17 @@ namespace
     for (const double nu : {0.0, 0.25, 0.4})
     {
       const std::string     text    = std::to_string(nu);
-      auto                  fem_bar = pulled_bar(text, "paper");
+      auto                  fem_bar = test_support::pulled_bar(text, "paper");
       fem::ElasticitySolver solver(fem::problem_from_scene(*fem_bar), {});
       const double          fem_nu =
-        effective_poisson_ratio(fem_bar->mesh, solver.solve_static().vertex);
-      auto         paper = pulled_bar(text, "paper");
-      const double paper_nu =
-        effective_poisson_ratio(paper->mesh,
-                                fem::solve_linearised_springs(*paper->system));
-      auto         fitted = pulled_bar(text, "fitted");
-      const double fitted_nu =
-        effective_poisson_ratio(fitted->mesh,
-                                fem::solve_linearised_springs(*fitted->system));
+        test_support::effective_poisson_ratio(fem_bar->mesh,
+                                              solver.solve_static().vertex);
+      auto         paper    = test_support::pulled_bar(text, "paper");
+      const double paper_nu = test_support::effective_poisson_ratio(
+        paper->mesh, fem::solve_linearised_springs(*paper->system));
+      auto         fitted    = test_support::pulled_bar(text, "fitted");
+      const double fitted_nu = test_support::effective_poisson_ratio(
+        fitted->mesh, fem::solve_linearised_springs(*fitted->system));
       std::cout << "asked nu " << nu << ": FEM P2 " << fem_nu << ", paper springs "
                 << paper_nu << ", fitted springs " << fitted_nu << "\n";
       EXPECT_NEAR(fem_nu, nu, 0.02);

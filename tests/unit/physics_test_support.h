@@ -13,7 +13,9 @@
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/tria.h>
 
+#include <deque>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace lacerta::test_support
@@ -36,13 +38,22 @@ namespace lacerta::test_support
   }
 
 
-  /// A particle system on @p mesh with constant density and Young's modulus.
+  /**
+   * A particle system on @p mesh with constant density and Young's modulus, force model
+   * @p model with Poisson ratio @p poisson_ratio. The system refers to @p mesh, which
+   * must outlive it.
+   */
   inline std::unique_ptr<physics::ParticleSystem>
   make_system(const mesh::TetMesh &mesh,
               const double         density,
               const double         youngs,
-              const unsigned int   n_threads = 1)
+              const unsigned int   n_threads     = 1,
+              const std::string   &model         = "linear springs",
+              const double         poisson_ratio = 0.25)
   {
+    // The moduli the systems refer to, for the whole test program.
+    static std::deque<dealii::Functions::ConstantFunction<3>> moduli;
+    moduli.emplace_back(youngs);
     std::vector<double> rest(3 * mesh.n_vertices());
     for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
       for (unsigned int d = 0; d < 3; ++d)
@@ -53,8 +64,10 @@ namespace lacerta::test_support
     system->springs =
       physics::compute_springs(mesh, dealii::Functions::ConstantFunction<3>(youngs));
     system->enforce_constraints = [](double, double *, double *) {};
-    system->set_force_model(physics::ForceModelRegistry::create("linear springs"),
-                            n_threads);
+    system->mesh                = &mesh;
+    system->youngs_modulus      = &moduli.back();
+    system->poisson_ratio       = poisson_ratio;
+    system->set_force_model(physics::ForceModelRegistry::create(model), n_threads);
     return system;
   }
 

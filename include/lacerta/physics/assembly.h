@@ -7,6 +7,8 @@
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/spring_set.h>
 
+#include <deal.II/lac/full_matrix.h>
+
 #include <array>
 #include <optional>
 #include <vector>
@@ -107,6 +109,17 @@ namespace lacerta::physics
   tet_stiffness_factor(const mesh::TetMesh               &mesh,
                        unsigned int                       t,
                        const dealii::Function<3, double> &youngs_modulus);
+
+  /// The Lamé parameters {λ, μ} of Young's modulus @p youngs and Poisson ratio @p nu.
+  std::array<double, 2>
+  lame_parameters(double youngs, double nu);
+
+  /**
+   * The 12x12 stiffness matrix of a linear (P1) tetrahedron with vertices @p x and
+   * Lamé parameters @p lambda, @p mu, rows and columns ordered (vertex, component).
+   */
+  dealii::FullMatrix<double>
+  p1_element_stiffness(const std::array<mesh::Point3, 4> &x, double lambda, double mu);
 
   /**
    * The stiffness of edge @p e = (a, b) from the tetrahedra around it, and its rest

@@ -6,6 +6,8 @@
 
 #include <lacerta/base/plugins.h>
 
+#include <array>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -82,9 +84,33 @@ namespace lacerta::physics
                           const double         *v,
                           double               *f) const = 0;
 
-    /// Elastic energy stored in the springs at positions @p x.
+    /// Elastic energy stored in the springs (and elements) at positions @p x.
     virtual double
     elastic_energy(const ParticleSystem &system, const double *x) const = 0;
+
+    /**
+     * The factor the model applies to the stiffness of the system's springs: 1 for the
+     * paper's springs, 0 for a model without springs. The stability bound scales the
+     * springs' terms by it.
+     */
+    virtual double
+    spring_stiffness_scale() const;
+
+    /// A 12x12 tangent stiffness of a tetrahedron, rows and columns ordered (local
+    /// vertex, component), row-major.
+    using ElementStiffness = std::array<double, 144>;
+
+    /**
+     * Calls @p visit(t, K) for every tetrahedron t of `system.mesh` with the tangent
+     * stiffness K of the model's per-tetrahedron term at positions @p x (what the
+     * stability bound adds to the springs' terms). A model of springs only visits
+     * nothing.
+     */
+    virtual void
+    for_each_element_stiffness(
+      const ParticleSystem                                              &system,
+      const double                                                      *x,
+      const std::function<void(unsigned int, const ElementStiffness &)> &visit) const;
 
     /// Declares `subsection Force model` with the `Model` selector.
     static void

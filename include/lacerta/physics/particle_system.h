@@ -11,6 +11,17 @@
 #include <memory>
 #include <vector>
 
+namespace dealii
+{
+  template <int dim, typename Number>
+  class Function;
+}
+
+namespace lacerta::mesh
+{
+  class TetMesh;
+}
+
 namespace lacerta::physics
 {
   class ForceModel;
@@ -50,6 +61,19 @@ namespace lacerta::physics
     double mass_damping = 0;
     /// Damping along springs, force -β k ((v_b - v_a)·n) n (s).
     double spring_damping = 0;
+
+    /**
+     * The tetrahedra of the particles (particle i is vertex i; the rest shapes are the
+     * mesh's vertices), for the force models per tetrahedron; set by whoever assembles
+     * the system, and changed in place by cuts before springs_changed(). May be null
+     * for the paper's springs.
+     */
+    const mesh::TetMesh *mesh = nullptr;
+    /// Young's modulus E(x) (Pa) of the force models per tetrahedron, evaluated at
+    /// centroids at rest, as for the springs; may be null for the paper's springs.
+    const dealii::Function<3, double> *youngs_modulus = nullptr;
+    /// The Poisson ratio the force models per tetrahedron reproduce.
+    double poisson_ratio = 0.25;
 
     /**
      * Called by the integrators at the end of every (sub)step to put the constrained
@@ -124,6 +148,13 @@ namespace lacerta::physics
     add_particle(const std::array<double, 3> &rest,
                  const std::array<double, 3> &x,
                  const std::array<double, 3> &v);
+
+    /// Whether a force model was set (set_force_model()).
+    bool
+    has_force_model() const
+    {
+      return forces != nullptr;
+    }
 
     /// The force model.
     const ForceModel &

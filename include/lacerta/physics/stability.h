@@ -44,7 +44,11 @@ namespace lacerta::physics
   /**
    * The mass-independent terms of the Gershgorin bound with the tangent stiffness of
    * every spring of @p system at @p positions (3 per particle; the rest positions give
-   * the bound of the undeformed system).
+   * the bound of the undeformed system), scaled as the force model scales the springs,
+   * plus the per-tetrahedron stiffness of the force model if it has one
+   * (ForceModel::for_each_element_stiffness()): the diagonal blocks of each element
+   * stiffness, and the norm of each off-diagonal block added to the spring of its edge.
+   * A system without a force model is bounded by its springs as they are.
    */
   GershgorinTerms
   gershgorin_terms(const ParticleSystem &system, const double *positions);
@@ -54,7 +58,8 @@ namespace lacerta::physics
    * particles: λ ≤ max_i [λ_max(Σ_e K_e) / m_i + Σ_e ||K_e|| / sqrt(m_i m_j)], with the
    * tangent stiffness of each spring at the current positions,
    * K_e = k n nᵀ + k (1 - L0/L)(I - n nᵀ), whose geometric part matters for strongly
-   * compressed springs. Constrained particles do not move and drop out.
+   * compressed springs. A force model per tetrahedron adds its element stiffness
+   * blocks (gershgorin_terms()). Constrained particles do not move and drop out.
    */
   FrequencyBound
   bound_highest_frequency(const ParticleSystem &system);

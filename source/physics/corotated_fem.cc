@@ -1,0 +1,405 @@
+// Force model `corotated fem`: explicit corotated linear elasticity on the P1
+// tetrahedra (Müller and Gross 2004), with the masses of Section 3.1.
+
+#include <lacerta/mesh/tet_mesh.h>
+#include <lacerta/physics/assembly.h>
+#include <lacerta/physics/force_model.h>
+#include <lacerta/physics/particle_ranges.h>
+#include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/partitioned_tets.h>
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+namespace lacerta::physics
+{
+  namespace
+  {
+    /// A 3x3 matrix, row-major.
+    using Matrix = std::array<double, 9>;
+
+    double
+    determinant(const Matrix &a)
+    {
+      return a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6])
+             + a[2] * (a[3] * a[7] - a[4] * a[6]);
+    }
+
+    /// The transpose of the inverse of @p a, whose determinant is @p det.
+    Matrix
+    inverse_transpose(const Matrix &a, const double det)
+    {
+      const double inv = 1.0 / det;
+      return {{(a[4] * a[8] - a[5] * a[7]) * inv,
+               (a[5] * a[6] - a[3] * a[8]) * inv,
+               (a[3] * a[7] - a[4] * a[6]) * inv,
+               (a[2] * a[7] - a[1] * a[8]) * inv,
+               (a[0] * a[8] - a[2] * a[6]) * inv,
+               (a[1] * a[6] - a[0] * a[7]) * inv,
+               (a[1] * a[5] - a[2] * a[4]) * inv,
+               (a[2] * a[3] - a[0] * a[5]) * inv,
+               (a[0] * a[4] - a[1] * a[3]) * inv}};
+    }
+
+    double
+    squared_norm(const Matrix &a)
+    {
+      double sum = 0;
+      for (const double x : a)
+        sum += x * x;
+      return sum;
+    }
+
+    /**
+     * The rotation R of deformation gradient @p F: if det F > 0 its polar factor
+     * (F = R S, S symmetric positive definite), by Higham's scaled Newton iteration
+     * X ← ½ (γ X + X⁻ᵀ / γ); otherwise (an inverted or flat element) the rotation of
+     * the Gram–Schmidt QR factorisation of F, which is always proper.
+     */
+    Matrix
+    rotation_of(const Matrix &F)
+    {
+      double det = determinant(F);
+      if (det > 0)
+      {
+        Matrix X = F;
+        for (unsigned int iteration = 0; iteration < 40; ++iteration)
+        {
+          const Matrix inverse_t = inverse_transpose(X, det);
+          const double gamma =
+            std::sqrt(std::sqrt(squared_norm(inverse_t) / squared_norm(X)));
+          double change = 0;
+          for (unsigned int k = 0; k < 9; ++k)
+          {
+            const double next = 0.5 * (gamma * X[k] + inverse_t[k] / gamma);
+            change += (next - X[k]) * (next - X[k]);
+            X[k] = next;
+          }
+          // Quadratic convergence: the next error is about change², below rounding.
+          if (change < 1e-18)
+            break;
+          det = determinant(X);
+        }
+        return X;
+      }
+      // Columns c0, c1 of F orthonormalised, c2 = c0 × c1.
+      double       c0[3] = {F[0], F[3], F[6]}, c1[3] = {F[1], F[4], F[7]};
+      const double n0 = std::sqrt(c0[0] * c0[0] + c0[1] * c0[1] + c0[2] * c0[2]);
+      if (!(n0 > 0))
+        return {{1, 0, 0, 0, 1, 0, 0, 0, 1}};
+      for (double &c : c0)
+        c /= n0;
+      const double dot = c0[0] * c1[0] + c0[1] * c1[1] + c0[2] * c1[2];
+      for (unsigned int d = 0; d < 3; ++d)
+        c1[d] -= dot * c0[d];
+      const double n1 = std::sqrt(c1[0] * c1[0] + c1[1] * c1[1] + c1[2] * c1[2]);
+      if (!(n1 > 0))
+        return {{1, 0, 0, 0, 1, 0, 0, 0, 1}};
+      for (double &c : c1)
+        c /= n1;
+      const double c2[3] = {c0[1] * c1[2] - c0[2] * c1[1],
+                            c0[2] * c1[0] - c0[0] * c1[2],
+                            c0[0] * c1[1] - c0[1] * c1[0]};
+      return {{c0[0], c1[0], c2[0], c0[1], c1[1], c2[1], c0[2], c1[2], c2[2]}};
+    }
+
+
+    /**
+     * Explicit corotated linear elasticity on the P1 tetrahedra: in every tetrahedron
+     * the deformation gradient F = D_s D_m⁻¹ (edge vectors now and at rest) is split
+     * into its rotation R (rotation_of()) and a stretch, and the tetrahedron stores
+     * V0 (μ |F - R|² + λ/2 tr(RᵀF - I)²), linear elasticity in the rotated frame. The
+     * forces are minus its gradient, -V0 P D_m⁻ᵀ with P = 2μ (F - R) +
+     * λ tr(RᵀF - I) R (the derivative of R drops out); at small rotations they are
+     * those of the P1 element stiffness. Damping along springs becomes Rayleigh damping
+     * β R K Rᵀ v. The masses are the system's (Section 3.1).
+     *
+     * Per-tetrahedron data are structures of arrays per thread range (PartitionedTets):
+     * each range evaluates the tetrahedra touching it and writes its own vertices
+     * only. After a cut or a tear the tetrahedra are copied again from the mesh:
+     * O(tetrahedra) per change.
+     */
+    class CorotatedFem : public ForceModel
+    {
+    public:
+      static void
+      declare_parameters(dealii::ParameterHandler &)
+      {
+      }
+
+      void
+      initialize(const ParticleSystem &system, const unsigned int n_threads) override
+      {
+        nu = checked_poisson_ratio(system, "corotated fem");
+        ranges.split(system, PartitionedTets::tets_per_particle(system), n_threads);
+        copy_tets(system);
+      }
+
+      void
+      springs_changed(const ParticleSystem &system,
+                      const std::vector<unsigned int> &) override
+      {
+        // New particles, new masses and new tetrahedra: everything is read again.
+        initialize(system, ranges.threads());
+      }
+
+      void
+      masses_changed(const ParticleSystem            &system,
+                     const std::vector<unsigned int> &particles) override
+      {
+        for (const unsigned int i : particles)
+          ranges.update_inverse_mass(system, i);
+      }
+
+      void
+      compute_acceleration(const ParticleSystem &system,
+                           const double         *x,
+                           const double         *v,
+                           double               *a) const override
+      {
+        ranges.for_each_part(
+          [&](const unsigned int p)
+          {
+            element_forces_of_part(system, p, x, v, a);
+            ranges.finish_accelerations(system, p, v, a);
+          });
+      }
+
+      void
+      compute_spring_forces(const ParticleSystem &system,
+                            const double         *x,
+                            const double         *v,
+                            double               *f) const override
+      {
+        ranges.for_each_part([&](const unsigned int p)
+                             { element_forces_of_part(system, p, x, v, f); });
+      }
+
+      double
+      elastic_energy(const ParticleSystem &, const double *x) const override
+      {
+        double energy = 0;
+        for (unsigned int p = 0; p < ranges.n_parts(); ++p)
+        {
+          const PartitionedTets::Part &part = tets.part(p);
+          for (std::size_t c = 0; c < part.size(); ++c)
+            // Each tetrahedron once: in the range that owns its local vertex 0.
+            if (part.owned[c] & 1u)
+            {
+              const Matrix F       = deformation_gradient(p, c, x);
+              const Matrix R       = rotation_of(F);
+              double       stretch = 0, trace = -3;
+              for (unsigned int k = 0; k < 9; ++k)
+                stretch += (F[k] - R[k]) * (F[k] - R[k]);
+              for (unsigned int k = 0; k < 9; ++k)
+                trace += R[k] * F[k];
+              energy += part.rest_volume[c]
+                        * (mu[p][c] * stretch + 0.5 * lambda[p][c] * trace * trace);
+            }
+        }
+        return energy;
+      }
+
+      double
+      spring_stiffness_scale() const override
+      {
+        return 0;
+      }
+
+      void
+      for_each_element_stiffness(
+        const ParticleSystem                                              &system,
+        const double                                                      *x,
+        const std::function<void(unsigned int, const ElementStiffness &)> &visit)
+        const override
+      {
+        for (unsigned int p = 0; p < ranges.n_parts(); ++p)
+        {
+          const PartitionedTets::Part &part = tets.part(p);
+          for (std::size_t c = 0; c < part.size(); ++c)
+            if (part.owned[c] & 1u)
+              visit(part.tet[c], rotated_stiffness(*system.mesh, p, c, x));
+        }
+      }
+
+    private:
+      /// Copies the tetrahedra into the ranges with D_m⁻¹, λ and μ of each copy.
+      void
+      copy_tets(const ParticleSystem &system)
+      {
+        tets.build(system, ranges);
+        const mesh::TetMesh &mesh = *system.mesh;
+        const unsigned int   n    = ranges.n_parts();
+        rest_inverse.assign(n, {});
+        lambda.assign(n, {});
+        mu.assign(n, {});
+        for (unsigned int p = 0; p < n; ++p)
+        {
+          const PartitionedTets::Part &part = tets.part(p);
+          for (std::size_t c = 0; c < part.size(); ++c)
+          {
+            const mesh::Tet &tet = mesh.tet(part.tet[c]);
+            Matrix           Dm;
+            for (unsigned int i = 0; i < 3; ++i)
+              for (unsigned int d = 0; d < 3; ++d)
+                Dm[3 * d + i] = mesh.vertex(tet[i + 1])[d] - mesh.vertex(tet[0])[d];
+            // D_m⁻¹ = (D_m⁻ᵀ)ᵀ.
+            const Matrix inverse_t = inverse_transpose(Dm, determinant(Dm));
+            for (unsigned int r = 0; r < 3; ++r)
+              for (unsigned int s = 0; s < 3; ++s)
+                rest_inverse[p][3 * r + s].push_back(inverse_t[3 * s + r]);
+            const auto [l, m] = lame_parameters(part.youngs_modulus[c], nu);
+            lambda[p].push_back(l);
+            mu[p].push_back(m);
+          }
+        }
+      }
+
+      /// F = D_s D_m⁻¹ of copy @p c of range @p p at positions @p x.
+      Matrix
+      deformation_gradient(const unsigned int p,
+                           const std::size_t  c,
+                           const double      *x) const
+      {
+        const PartitionedTets::Part &part = tets.part(p);
+        const double                *x0   = x + 3 * part.vertex[0][c];
+        Matrix                       Ds;
+        for (unsigned int i = 0; i < 3; ++i)
+        {
+          const double *xi = x + 3 * part.vertex[i + 1][c];
+          for (unsigned int d = 0; d < 3; ++d)
+            Ds[3 * d + i] = xi[d] - x0[d];
+        }
+        Matrix F{};
+        for (unsigned int r = 0; r < 3; ++r)
+          for (unsigned int s = 0; s < 3; ++s)
+            for (unsigned int k = 0; k < 3; ++k)
+              F[3 * r + s] += Ds[3 * r + k] * rest_inverse[p][3 * k + s][c];
+        return F;
+      }
+
+      /**
+       * The stress P of copy @p c: 2μ (F - R) + λ tr(RᵀF - I) R, plus with β > 0 the
+       * damping stress β R (2μ sym(RᵀḞ) + λ tr(RᵀḞ) I).
+       */
+      Matrix
+      stress(const unsigned int p,
+             const std::size_t  c,
+             const double      *x,
+             const double      *v,
+             const double       beta) const
+      {
+        const Matrix F = deformation_gradient(p, c, x);
+        const Matrix R = rotation_of(F);
+        const double l = lambda[p][c], m = mu[p][c];
+        double       trace = -3;
+        for (unsigned int k = 0; k < 9; ++k)
+          trace += R[k] * F[k];
+        Matrix P;
+        for (unsigned int k = 0; k < 9; ++k)
+          P[k] = 2 * m * (F[k] - R[k]) + l * trace * R[k];
+        if (beta > 0)
+        {
+          // G = Rᵀ Ḟ, the velocity gradient in the rotated frame.
+          const Matrix Fdot = deformation_gradient(p, c, v);
+          Matrix       G{};
+          for (unsigned int r = 0; r < 3; ++r)
+            for (unsigned int s = 0; s < 3; ++s)
+              for (unsigned int k = 0; k < 3; ++k)
+                G[3 * r + s] += R[3 * k + r] * Fdot[3 * k + s];
+          const double rate = G[0] + G[4] + G[8];
+          Matrix       sigma;
+          for (unsigned int r = 0; r < 3; ++r)
+            for (unsigned int s = 0; s < 3; ++s)
+              sigma[3 * r + s] =
+                beta * (m * (G[3 * r + s] + G[3 * s + r]) + (r == s ? l * rate : 0.0));
+          for (unsigned int r = 0; r < 3; ++r)
+            for (unsigned int s = 0; s < 3; ++s)
+              for (unsigned int k = 0; k < 3; ++k)
+                P[3 * r + s] += R[3 * r + k] * sigma[3 * k + s];
+        }
+        return P;
+      }
+
+      /// Zeroes the forces of range @p p's particles and adds its tetrahedra's forces.
+      void
+      element_forces_of_part(const ParticleSystem &system,
+                             const unsigned int    p,
+                             const double         *x,
+                             const double         *v,
+                             double               *f) const
+      {
+        ranges.zero(p, f);
+        const PartitionedTets::Part &part = tets.part(p);
+        const double                 beta = system.spring_damping;
+        for (std::size_t c = 0; c < part.size(); ++c)
+        {
+          const Matrix P = stress(p, c, x, v, beta);
+          // Forces on vertices 1..3: the columns of -V0 P D_m⁻ᵀ.
+          double force[4][3] = {};
+          for (unsigned int i = 0; i < 3; ++i)
+            for (unsigned int d = 0; d < 3; ++d)
+            {
+              double sum = 0;
+              for (unsigned int k = 0; k < 3; ++k)
+                sum += P[3 * d + k] * rest_inverse[p][3 * i + k][c];
+              force[i + 1][d] = -part.rest_volume[c] * sum;
+              force[0][d] -= force[i + 1][d];
+            }
+          const unsigned char owned = part.owned[c];
+          for (unsigned int i = 0; i < 4; ++i)
+            if (owned & (1u << i))
+            {
+              double *target = f + 3 * part.vertex[i][c];
+              for (unsigned int d = 0; d < 3; ++d)
+                target[d] += force[i][d];
+            }
+        }
+      }
+
+      /// R K Rᵀ of copy @p c, K the P1 element stiffness at rest, R its rotation at x.
+      ElementStiffness
+      rotated_stiffness(const mesh::TetMesh &mesh,
+                        const unsigned int   p,
+                        const std::size_t    c,
+                        const double        *x) const
+      {
+        const Matrix                R = rotation_of(deformation_gradient(p, c, x));
+        std::array<mesh::Point3, 4> rest;
+        for (unsigned int i = 0; i < 4; ++i)
+          rest[i] = mesh.vertex(mesh.tet(tets.part(p).tet[c])[i]);
+        const dealii::FullMatrix<double> K =
+          p1_element_stiffness(rest, lambda[p][c], mu[p][c]);
+        ElementStiffness rotated{};
+        for (unsigned int a = 0; a < 4; ++a)
+          for (unsigned int b = 0; b < 4; ++b)
+            for (unsigned int r = 0; r < 3; ++r)
+              for (unsigned int s = 0; s < 3; ++s)
+              {
+                double sum = 0;
+                for (unsigned int k = 0; k < 3; ++k)
+                  for (unsigned int l = 0; l < 3; ++l)
+                    sum += R[3 * r + k] * K(3 * a + k, 3 * b + l) * R[3 * s + l];
+                rotated[12 * (3 * a + r) + 3 * b + s] = sum;
+              }
+        return rotated;
+      }
+
+      double          nu = 0.25;
+      ParticleRanges  ranges;
+      PartitionedTets tets;
+      /// D_m⁻¹ of every copy, entry (r, s) in array 3 r + s, per range.
+      std::vector<std::array<std::vector<double>, 9>> rest_inverse;
+      /// λ and μ of every copy (Pa), per range.
+      std::vector<std::vector<double>> lambda, mu;
+    };
+  } // namespace
+
+  LACERTA_REGISTER_FORCE_MODEL(
+    CorotatedFem,
+    "corotated fem",
+    "Explicit corotated linear elasticity on the P1 tetrahedra (Mueller and Gross "
+    "2004) with E and 'Material/Poisson ratio', rotations by polar decomposition; the "
+    "springs then only tell where the tissue tears (doc/physics.md).");
+} // namespace lacerta::physics
