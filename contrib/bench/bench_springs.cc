@@ -1,4 +1,5 @@
-// lacerta-bench springs: force-evaluation throughput of the spring loop.
+// lacerta-bench springs: force-evaluation throughput of the spring loop;
+// lacerta-bench force-models: the same for every force model, per tetrahedron.
 
 #include <lacerta/mesh/triangulation_conversion.h>
 #include <lacerta/physics/assembly.h>
@@ -10,6 +11,7 @@
 #include <deal.II/grid/tria.h>
 
 #include "benchmark_registry.h"
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -18,9 +20,15 @@ namespace lacerta::bench
 {
   namespace
   {
-    /// A particle system on a box of n x n x n hexahedra split into tetrahedra.
+    const dealii::Functions::ConstantFunction<3> youngs_modulus(1e5);
+
+    /// A particle system on a box of n x n x n hexahedra split into tetrahedra, with
+    /// force model @p model.
     std::unique_ptr<physics::ParticleSystem>
-    make_system(const unsigned int n, const unsigned int n_threads, mesh::TetMesh &mesh)
+    make_system(const unsigned int n,
+                const unsigned int n_threads,
+                mesh::TetMesh     &mesh,
+                const std::string &model = "linear springs")
     {
       dealii::Triangulation<3> tria;
       dealii::GridGenerator::subdivided_hyper_rectangle_with_simplices(
@@ -34,22 +42,24 @@ namespace lacerta::bench
       auto system = std::make_unique<physics::ParticleSystem>(rest);
       system->mass =
         physics::compute_masses(mesh, dealii::Functions::ConstantFunction<3>(1000));
-      system->springs =
-        physics::compute_springs(mesh, dealii::Functions::ConstantFunction<3>(1e5));
+      system->springs        = physics::compute_springs(mesh, youngs_modulus);
+      system->mesh           = &mesh;
+      system->youngs_modulus = &youngs_modulus;
+      system->poisson_ratio  = 0.45;
       // A deformed state, so that no spring is at rest length.
       std::mt19937                           random(1);
       std::uniform_real_distribution<double> uniform(-1e-4, 1e-4);
       for (double &x : system->position)
         x += uniform(random);
-      system->set_force_model(physics::ForceModelRegistry::create("linear springs"),
-                              n_threads);
+      system->set_force_model(physics::ForceModelRegistry::create(model), n_threads);
       return system;
     }
 
 
-    /// Springs per second of compute_acceleration(), best of several timed batches.
+    /// Evaluations per second of compute_acceleration() times @p items (springs or
+    /// tetrahedra per evaluation), best of several timed batches.
     double
-    throughput(const physics::ParticleSystem &system)
+    throughput(const physics::ParticleSystem &system, const double items)
     {
       std::vector<double> a(system.position.size());
       const double       *x = system.position.data();
@@ -76,7 +86,7 @@ namespace lacerta::bench
           system.compute_acceleration(x, v, a.data());
         const double seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        best = std::max(best, double(system.springs.size()) * repetitions / seconds);
+        best = std::max(best, items * repetitions / seconds);
       }
       return best;
     }
@@ -94,8 +104,8 @@ namespace lacerta::bench
         mesh::TetMesh     mesh;
         auto              one      = make_system(n, 1, mesh);
         auto              two      = make_system(n, 2, mesh);
-        const double      rate_one = throughput(*one);
-        const double      rate_two = throughput(*two);
+        const double      rate_one = throughput(*one, one->springs.size());
+        const double      rate_two = throughput(*two, two->springs.size());
         const std::string tag      = "springs_" + std::to_string(one->springs.size());
         print_figure(tag + "_particles", one->n_particles(), "particles");
         print_figure(tag + "_one_core", rate_one / 1e6, "M springs/s");
@@ -109,7 +119,41 @@ namespace lacerta::bench
       print_figure("springs_worst_speedup", worst_speedup, "x");
       return 0;
     }
+
+
+    int
+    run_models(const std::vector<std::string> &arguments)
+    {
+      std::vector<unsigned int> sizes = {22, 35};
+      if (!arguments.empty() && arguments[0] == "--quick")
+        sizes = {12};
+      for (const unsigned int n : sizes)
+        for (const std::string model :
+             {"linear springs", "volume springs", "corotated fem"})
+        {
+          mesh::TetMesh mesh;
+          auto          one      = make_system(n, 1, mesh, model);
+          auto          two      = make_system(n, 2, mesh, model);
+          const double  rate_one = throughput(*one, mesh.n_tets());
+          const double  rate_two = throughput(*two, mesh.n_tets());
+          std::string   tag      = model;
+          std::replace(tag.begin(), tag.end(), ' ', '_');
+          tag += "_" + std::to_string(mesh.n_tets());
+          print_figure(tag + "_one_core", rate_one / 1e6, "M tetrahedra/s");
+          print_figure(tag + "_two_cores", rate_two / 1e6, "M tetrahedra/s");
+          print_figure(tag + "_per_core_on_two", rate_two / 2e6, "M tetrahedra/s");
+          print_figure(tag + "_ns_per_tetrahedron", 1e9 / rate_one, "ns");
+        }
+      return 0;
+    }
   } // namespace
+
+  LACERTA_REGISTER_BENCHMARK(
+    "force-models",
+    "Force evaluation throughput of every force model in tetrahedra per second, on one "
+    "and two cores, boxes of 53,240 and 214,375 tetrahedra at nu = 0.45 (--quick: "
+    "8,640).",
+    run_models);
 
   LACERTA_REGISTER_BENCHMARK(
     "springs",
