@@ -1,6 +1,7 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/fem/spring_statics.h>
 #include <lacerta/fem/subspace_iteration.h>
+#include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/force_model.h>
 #include <lacerta/physics/particle_system.h>
 
@@ -20,8 +21,10 @@ namespace lacerta::fem
     using namespace dealii;
 
     /**
-     * The linearised spring stiffness, unconstrained and with the constrained particles'
-     * rows and columns eliminated, with its sparsity pattern.
+     * The stiffness of the system's force model linearised at rest (the springs, scaled
+     * as the model scales them, plus the model's element stiffnesses per tetrahedron),
+     * unconstrained and with the constrained particles' rows and columns eliminated,
+     * with its sparsity pattern (every pair of vertices of a tetrahedron is a spring).
      */
     struct SpringStiffness
     {
@@ -48,10 +51,12 @@ namespace lacerta::fem
         full.reinit(pattern);
         constrained.reinit(pattern);
 
+        const double scale =
+          system.has_force_model() ? system.force_model().spring_stiffness_scale() : 1.0;
         const auto                          &rest = system.rest_position();
         FullMatrix<double>                   local(6, 6);
         std::vector<types::global_dof_index> dofs(6);
-        for (std::size_t s = 0; s < springs.size(); ++s)
+        for (std::size_t s = 0; s < springs.size() && scale != 0; ++s)
         {
           const unsigned int a = springs.a[s], b = springs.b[s];
           double             n_ab[3], length     = 0;
@@ -70,19 +75,46 @@ namespace lacerta::fem
             for (unsigned int e = 0; e < 3; ++e)
             {
               const double k =
-                springs.stiffness[s] * n_ab[d] * n_ab[e] / (length * length);
+                scale * springs.stiffness[s] * n_ab[d] * n_ab[e] / (length * length);
               local(d, e) = local(3 + d, 3 + e) = k;
               local(d, 3 + e) = local(3 + d, e) = -k;
             }
-          for (unsigned int i = 0; i < 6; ++i)
-            for (unsigned int j = 0; j < 6; ++j)
-              full.add(dofs[i], dofs[j], local(i, j));
-          constraints.distribute_local_to_global(local, dofs, constrained);
+          add(local, dofs);
+        }
+        if (system.has_force_model())
+        {
+          FullMatrix<double> element(12, 12);
+          dofs.resize(12);
+          system.force_model().for_each_element_stiffness(
+            system,
+            rest.data(),
+            [&](const unsigned int t, const physics::ForceModel::ElementStiffness &K)
+            {
+              const auto &tet = system.mesh->tet(t);
+              for (unsigned int i = 0; i < 12; ++i)
+              {
+                dofs[i] = 3 * tet[i / 3] + i % 3;
+                for (unsigned int j = 0; j < 12; ++j)
+                  element(i, j) = K[12 * i + j];
+              }
+              add(element, dofs);
+            });
         }
         // A particle joined to nothing free would leave a zero row.
         for (unsigned int i = 0; i < n; ++i)
           if (constrained.diag_element(i) == 0)
             constrained.set(i, i, 1.0);
+      }
+
+      /// Adds a local matrix on @p dofs to both matrices.
+      void
+      add(const FullMatrix<double>                   &local,
+          const std::vector<types::global_dof_index> &dofs)
+      {
+        for (unsigned int i = 0; i < dofs.size(); ++i)
+          for (unsigned int j = 0; j < dofs.size(); ++j)
+            full.add(dofs[i], dofs[j], local(i, j));
+        constraints.distribute_local_to_global(local, dofs, constrained);
       }
 
       AffineConstraints<double> constraints;
@@ -126,10 +158,37 @@ namespace lacerta::fem
     const unsigned int  n = system.n_particles();
     std::vector<double> fictitious(n, 0.0);
     const auto         &springs = system.springs;
+    const double        scale =
+      system.has_force_model() ? system.force_model().spring_stiffness_scale() : 1.0;
     for (std::size_t s = 0; s < springs.size(); ++s)
     {
-      fictitious[springs.a[s]] += std::sqrt(3.0) * springs.stiffness[s];
-      fictitious[springs.b[s]] += std::sqrt(3.0) * springs.stiffness[s];
+      fictitious[springs.a[s]] += std::sqrt(3.0) * scale * springs.stiffness[s];
+      fictitious[springs.b[s]] += std::sqrt(3.0) * scale * springs.stiffness[s];
+    }
+    // The model's tetrahedra: every element adds at most its largest row sum at each
+    // of its vertices (Gershgorin), counted once per element around the particle.
+    if (system.has_force_model() && system.mesh)
+    {
+      std::vector<double> element_bound(n, 0.0);
+      system.force_model().for_each_element_stiffness(
+        system,
+        system.rest_position().data(),
+        [&](const unsigned int t, const physics::ForceModel::ElementStiffness &K)
+        {
+          const auto &tet = system.mesh->tet(t);
+          for (unsigned int i = 0; i < 12; ++i)
+          {
+            double row = 0;
+            for (unsigned int j = 0; j < 12; ++j)
+              row += std::abs(K[12 * i + j]);
+            element_bound[tet[i / 3]] = std::max(element_bound[tet[i / 3]], row);
+          }
+          for (const unsigned int v : tet)
+          {
+            fictitious[v] += element_bound[v];
+            element_bound[v] = 0;
+          }
+        });
     }
     std::vector<double> load(3 * n), force(3 * n), zero(3 * n, 0.0), v(3 * n, 0.0);
     double              largest_load = 0;

@@ -404,3 +404,41 @@ namespace
     EXPECT_LT(errors[2][1], errors[1][1]);
   }
 } // namespace
+
+
+namespace
+{
+  using namespace lacerta;
+
+  /// The statics and frequencies of a model per tetrahedron are those of its own
+  /// linearisation: corotated FEM linearised at rest is linear P1 elasticity, so its
+  /// small-strain equilibrium is FEM P1's on the same tetrahedra, and dynamic relaxation
+  /// of its nonlinear forces agrees with it.
+  TEST(SpringStatics, LinearisedCorotatedFemIsFemP1)
+  {
+    auto bar = test_support::pulled_bar("0.45", "paper", "corotated fem");
+    fem::SolverParameters p1;
+    p1.degree = 1;
+    fem::ElasticitySolver     solver(fem::problem_from_scene(*bar), p1);
+    const std::vector<double> fem    = solver.solve_static().vertex;
+    const std::vector<double> direct = fem::solve_linearised_springs(*bar->system);
+    ASSERT_EQ(fem.size(), direct.size());
+    double largest = 0, difference = 0;
+    for (std::size_t k = 0; k < fem.size(); ++k)
+    {
+      largest    = std::max(largest, std::abs(fem[k]));
+      difference = std::max(difference, std::abs(fem[k] - direct[k]));
+    }
+    EXPECT_GT(largest, 0);
+    EXPECT_LT(difference, 1e-7 * largest);
+    EXPECT_NEAR(test_support::effective_poisson_ratio(bar->mesh, direct), 0.45, 0.01);
+
+    // The pull is small (1 N on 4e-4 m² of E = 1 MPa: a strain of 2.5e-3), so the
+    // nonlinear equilibrium is within a few per cent of the linear one.
+    const fem::RelaxationResult relaxed = fem::relax_springs(*bar->system, 1e-7);
+    double                      gap     = 0;
+    for (std::size_t k = 0; k < direct.size(); ++k)
+      gap = std::max(gap, std::abs(relaxed.displacement[k] - direct[k]));
+    EXPECT_LT(gap, 0.05 * largest);
+  }
+} // namespace

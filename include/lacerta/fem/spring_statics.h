@@ -17,7 +17,9 @@ namespace lacerta::fem
 {
   /**
    * Displacements (3 per particle) of the small-strain equilibrium K u = f of the
-   * springs linearised at rest, K = Σ k n nᵀ per spring with n its rest direction;
+   * system's force model linearised at rest: K = Σ k n nᵀ per spring with n its rest
+   * direction (scaled as the model scales the springs) plus the model's element
+   * stiffness per tetrahedron (ForceModel::for_each_element_stiffness());
    * f = m g + the external forces. The constrained particles keep their current
    * displacement (the caller puts them where the scene prescribes them first). Solved by
    * a sparse direct factorisation (UMFPACK).
@@ -39,11 +41,13 @@ namespace lacerta::fem
 
   /**
    * Steady state of the explicit (nonlinear) spring model by dynamic relaxation:
-   * leapfrog steps with fictitious masses m̃_i = √3 Σ k (which make a unit step stable
-   * by Gershgorin) and kinetic damping (velocities reset whenever the kinetic energy
-   * falls), until the largest residual force is below @p tolerance times the largest
-   * load. The forces are the system's own force model. Moves @p system's positions to
-   * the equilibrium; throws an Error if @p max_iterations do not reach it.
+   * leapfrog steps with fictitious masses m̃_i = √3 Σ k (scaled as the model scales the
+   * springs) plus, per tetrahedron of the model, the largest absolute row sum of its
+   * element stiffness at i (which make a unit step stable by Gershgorin) and kinetic
+   * damping (velocities reset whenever the kinetic energy falls), until the largest
+   * residual force is below @p tolerance times the largest load. The forces are the
+   * system's own force model. Moves @p system's positions to the equilibrium; throws an
+   * Error if @p max_iterations do not reach it.
    */
   RelaxationResult
   relax_springs(physics::ParticleSystem &system,
@@ -51,8 +55,9 @@ namespace lacerta::fem
                 unsigned int             max_iterations = 2000000);
 
   /**
-   * The @p n lowest vibration frequencies (Hz) of the springs linearised at rest with
-   * lumped masses, the constrained particles held.
+   * The @p n lowest vibration frequencies (Hz) of the system's force model linearised
+   * at rest (as solve_linearised_springs()) with lumped masses, the constrained
+   * particles held.
    */
   std::vector<double>
   spring_frequencies(const physics::ParticleSystem &system, unsigned int n);
