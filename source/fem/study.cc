@@ -37,11 +37,21 @@ namespace lacerta::fem
     using Samples = std::vector<std::vector<double>>;
 
     /// The scene of @p prm with its box refined @p factor times and springs as asked.
+    /// The force model of a study model of particles.
+    std::string
+    force_model_of(const std::string &model)
+    {
+      return model == "volume springs" || model == "corotated fem" ? model
+                                                                   : "linear springs";
+    }
+
+
     std::unique_ptr<scene::Scene>
     make_scene(dealii::ParameterHandler &prm,
                const unsigned int        factor,
-               const bool                fitted)
+               const std::string        &model)
     {
+      const bool fitted = model == "fitted springs";
       prm.enter_subsection("Mesh");
       if (prm.get("Source") != "box")
         throw_error("Study: 'Refinements' multiply 'Mesh/Box/Repetitions', so the scene "
@@ -61,8 +71,16 @@ namespace lacerta::fem
       const std::string stiffness = prm.get("Spring stiffness");
       prm.set("Spring stiffness", fitted ? "fitted" : "paper");
       prm.leave_subsection();
+      prm.enter_subsection("Force model");
+      const std::string force_model = prm.get("Model");
+      prm.set("Model", force_model_of(model));
+      prm.leave_subsection();
 
       auto scene = std::make_unique<scene::Scene>(prm, 1);
+
+      prm.enter_subsection("Force model");
+      prm.set("Model", force_model);
+      prm.leave_subsection();
 
       prm.enter_subsection("Mesh");
       prm.enter_subsection("Box");
@@ -178,12 +196,15 @@ namespace lacerta::fem
       dealii::Patterns::List(dealii::Patterns::Integer(1, 16), 1, 16, ","),
       "Mesh resolutions of the variants, as factors on "
       "'Mesh/Box/Repetitions' (the scene must use the box source).");
-    prm.declare_entry("Models",
-                      "springs, fitted springs, fem p1, fem p2",
-                      dealii::Patterns::MultipleSelection(
-                        "springs|fitted springs|fem p1|fem p2"),
-                      "Models of the variants: the paper's springs (k = E V/|e|^2), "
-                      "springs fitted to linear elasticity, FEM of degree 1 or 2.");
+    prm.declare_entry(
+      "Models",
+      "springs, fitted springs, fem p1, fem p2",
+      dealii::Patterns::MultipleSelection(
+        "springs|fitted springs|volume springs|corotated fem|fem p1|fem p2"),
+      "Models of the variants: the paper's springs (k = E V/|e|^2), "
+      "springs fitted to linear elasticity, the force models 'volume "
+      "springs' and 'corotated fem' (with the scene's 'Force model' "
+      "subsection for their parameters), FEM of degree 1 or 2.");
     prm.declare_entry(
       "Integrators",
       "direct, relaxation",
@@ -288,7 +309,7 @@ namespace lacerta::fem
       sample_times.push_back(end_time);
 
     // The reference: FEM P2 on the refined mesh.
-    auto             reference_scene = make_scene(prm, reference_refinement, false);
+    auto             reference_scene = make_scene(prm, reference_refinement, "springs");
     SolverParameters p2;
     p2.degree    = 2;
     p2.tolerance = 1e-11;
@@ -332,9 +353,8 @@ namespace lacerta::fem
     for (const unsigned int refinement : refinements)
       for (const std::string &model : models)
       {
-        const bool fem    = model.rfind("fem", 0) == 0;
-        const bool fitted = model == "fitted springs";
-        auto       scene  = make_scene(prm, refinement, fitted);
+        const bool fem   = model.rfind("fem", 0) == 0;
+        auto       scene = make_scene(prm, refinement, model);
         if (n_frequencies > 0)
         {
           const std::string label = model + " x" + std::to_string(refinement);
@@ -421,7 +441,7 @@ namespace lacerta::fem
             explicit_scheme ? time_steps : std::vector<double>{0.0};
           for (const double dt : steps)
           {
-            auto                     variant = make_scene(prm, refinement, fitted);
+            auto                     variant = make_scene(prm, refinement, model);
             physics::ParticleSystem &system  = *variant->system;
             variant->update_loads(end_time);
             system.enforce_constraints(end_time,
