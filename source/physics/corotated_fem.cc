@@ -4,6 +4,7 @@
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/assembly.h>
 #include <lacerta/physics/force_model.h>
+#include <lacerta/physics/matrix3.h>
 #include <lacerta/physics/particle_ranges.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/partitioned_tets.h>
@@ -16,58 +17,23 @@ namespace lacerta::physics
 {
   namespace
   {
-    /// A 3x3 matrix, row-major.
-    using Matrix = std::array<double, 9>;
-
-    double
-    determinant(const Matrix &a)
-    {
-      return a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6])
-             + a[2] * (a[3] * a[7] - a[4] * a[6]);
-    }
-
-    /// The transpose of the inverse of @p a, whose determinant is @p det.
-    Matrix
-    inverse_transpose(const Matrix &a, const double det)
-    {
-      const double inv = 1.0 / det;
-      return {{(a[4] * a[8] - a[5] * a[7]) * inv,
-               (a[5] * a[6] - a[3] * a[8]) * inv,
-               (a[3] * a[7] - a[4] * a[6]) * inv,
-               (a[2] * a[7] - a[1] * a[8]) * inv,
-               (a[0] * a[8] - a[2] * a[6]) * inv,
-               (a[1] * a[6] - a[0] * a[7]) * inv,
-               (a[1] * a[5] - a[2] * a[4]) * inv,
-               (a[2] * a[3] - a[0] * a[5]) * inv,
-               (a[0] * a[4] - a[1] * a[3]) * inv}};
-    }
-
-    double
-    squared_norm(const Matrix &a)
-    {
-      double sum = 0;
-      for (const double x : a)
-        sum += x * x;
-      return sum;
-    }
-
     /**
      * The rotation R of deformation gradient @p F: if det F > 0 its polar factor
      * (F = R S, S symmetric positive definite), by Higham's scaled Newton iteration
      * X ← ½ (γ X + X⁻ᵀ / γ); otherwise (an inverted or flat element) the rotation of
      * the Gram–Schmidt QR factorisation of F, which is always proper.
      */
-    Matrix
-    rotation_of(const Matrix &F)
+    Matrix3
+    rotation_of(const Matrix3 &F)
     {
       double det = determinant(F);
       if (det > 0)
       {
-        Matrix X = F;
+        Matrix3 X = F;
         for (unsigned int iteration = 0; iteration < 40; ++iteration)
         {
-          const Matrix inverse_t = inverse_transpose(X, det);
-          const double gamma =
+          const Matrix3 inverse_t = inverse_transpose(X, det);
+          const double  gamma =
             std::sqrt(std::sqrt(squared_norm(inverse_t) / squared_norm(X)));
           double change = 0;
           for (unsigned int k = 0; k < 9; ++k)
@@ -187,9 +153,9 @@ namespace lacerta::physics
             // Each tetrahedron once: in the range that owns its local vertex 0.
             if (part.owned[c] & 1u)
             {
-              const Matrix F       = deformation_gradient(p, c, x);
-              const Matrix R       = rotation_of(F);
-              double       stretch = 0, trace = -3;
+              const Matrix3 F       = tets.part(p).deformation_gradient(c, x);
+              const Matrix3 R       = rotation_of(F);
+              double        stretch = 0, trace = -3;
               for (unsigned int k = 0; k < 9; ++k)
                 stretch += (F[k] - R[k]) * (F[k] - R[k]);
               for (unsigned int k = 0; k < 9; ++k)
@@ -224,92 +190,57 @@ namespace lacerta::physics
       }
 
     private:
-      /// Copies the tetrahedra into the ranges with D_m⁻¹, λ and μ of each copy.
+      /// Copies the tetrahedra into the ranges with λ and μ of each copy.
       void
       copy_tets(const ParticleSystem &system)
       {
         tets.build(system, ranges);
-        const mesh::TetMesh &mesh = *system.mesh;
-        const unsigned int   n    = ranges.n_parts();
-        rest_inverse.assign(n, {});
+        const unsigned int n = ranges.n_parts();
         lambda.assign(n, {});
         mu.assign(n, {});
         for (unsigned int p = 0; p < n; ++p)
         {
           const PartitionedTets::Part &part = tets.part(p);
-          for (std::size_t c = 0; c < part.size(); ++c)
+          for (const double youngs : part.youngs_modulus)
           {
-            const mesh::Tet &tet = mesh.tet(part.tet[c]);
-            Matrix           Dm;
-            for (unsigned int i = 0; i < 3; ++i)
-              for (unsigned int d = 0; d < 3; ++d)
-                Dm[3 * d + i] = mesh.vertex(tet[i + 1])[d] - mesh.vertex(tet[0])[d];
-            // D_m⁻¹ = (D_m⁻ᵀ)ᵀ.
-            const Matrix inverse_t = inverse_transpose(Dm, determinant(Dm));
-            for (unsigned int r = 0; r < 3; ++r)
-              for (unsigned int s = 0; s < 3; ++s)
-                rest_inverse[p][3 * r + s].push_back(inverse_t[3 * s + r]);
-            const auto [l, m] = lame_parameters(part.youngs_modulus[c], nu);
+            const auto [l, m] = lame_parameters(youngs, nu);
             lambda[p].push_back(l);
             mu[p].push_back(m);
           }
         }
       }
 
-      /// F = D_s D_m⁻¹ of copy @p c of range @p p at positions @p x.
-      Matrix
-      deformation_gradient(const unsigned int p,
-                           const std::size_t  c,
-                           const double      *x) const
-      {
-        const PartitionedTets::Part &part = tets.part(p);
-        const double                *x0   = x + 3 * part.vertex[0][c];
-        Matrix                       Ds;
-        for (unsigned int i = 0; i < 3; ++i)
-        {
-          const double *xi = x + 3 * part.vertex[i + 1][c];
-          for (unsigned int d = 0; d < 3; ++d)
-            Ds[3 * d + i] = xi[d] - x0[d];
-        }
-        Matrix F{};
-        for (unsigned int r = 0; r < 3; ++r)
-          for (unsigned int s = 0; s < 3; ++s)
-            for (unsigned int k = 0; k < 3; ++k)
-              F[3 * r + s] += Ds[3 * r + k] * rest_inverse[p][3 * k + s][c];
-        return F;
-      }
-
       /**
        * The stress P of copy @p c: 2μ (F - R) + λ tr(RᵀF - I) R, plus with β > 0 the
        * damping stress β R (2μ sym(RᵀḞ) + λ tr(RᵀḞ) I).
        */
-      Matrix
+      Matrix3
       stress(const unsigned int p,
              const std::size_t  c,
              const double      *x,
              const double      *v,
              const double       beta) const
       {
-        const Matrix F = deformation_gradient(p, c, x);
-        const Matrix R = rotation_of(F);
-        const double l = lambda[p][c], m = mu[p][c];
-        double       trace = -3;
+        const Matrix3 F = tets.part(p).deformation_gradient(c, x);
+        const Matrix3 R = rotation_of(F);
+        const double  l = lambda[p][c], m = mu[p][c];
+        double        trace = -3;
         for (unsigned int k = 0; k < 9; ++k)
           trace += R[k] * F[k];
-        Matrix P;
+        Matrix3 P;
         for (unsigned int k = 0; k < 9; ++k)
           P[k] = 2 * m * (F[k] - R[k]) + l * trace * R[k];
         if (beta > 0)
         {
           // G = Rᵀ Ḟ, the velocity gradient in the rotated frame.
-          const Matrix Fdot = deformation_gradient(p, c, v);
-          Matrix       G{};
+          const Matrix3 Fdot = tets.part(p).deformation_gradient(c, v);
+          Matrix3       G{};
           for (unsigned int r = 0; r < 3; ++r)
             for (unsigned int s = 0; s < 3; ++s)
               for (unsigned int k = 0; k < 3; ++k)
                 G[3 * r + s] += R[3 * k + r] * Fdot[3 * k + s];
           const double rate = G[0] + G[4] + G[8];
-          Matrix       sigma;
+          Matrix3      sigma;
           for (unsigned int r = 0; r < 3; ++r)
             for (unsigned int s = 0; s < 3; ++s)
               sigma[3 * r + s] =
@@ -335,26 +266,7 @@ namespace lacerta::physics
         const double                 beta = system.spring_damping;
         for (std::size_t c = 0; c < part.size(); ++c)
         {
-          const Matrix P = stress(p, c, x, v, beta);
-          // Forces on vertices 1..3: the columns of -V0 P D_m⁻ᵀ.
-          double force[4][3] = {};
-          for (unsigned int i = 0; i < 3; ++i)
-            for (unsigned int d = 0; d < 3; ++d)
-            {
-              double sum = 0;
-              for (unsigned int k = 0; k < 3; ++k)
-                sum += P[3 * d + k] * rest_inverse[p][3 * i + k][c];
-              force[i + 1][d] = -part.rest_volume[c] * sum;
-              force[0][d] -= force[i + 1][d];
-            }
-          const unsigned char owned = part.owned[c];
-          for (unsigned int i = 0; i < 4; ++i)
-            if (owned & (1u << i))
-            {
-              double *target = f + 3 * part.vertex[i][c];
-              for (unsigned int d = 0; d < 3; ++d)
-                target[d] += force[i][d];
-            }
+          part.add_owned_nodal_forces(c, stress(p, c, x, v, beta), f);
         }
       }
 
@@ -365,7 +277,7 @@ namespace lacerta::physics
                         const std::size_t    c,
                         const double        *x) const
       {
-        const Matrix                R = rotation_of(deformation_gradient(p, c, x));
+        const Matrix3 R = rotation_of(tets.part(p).deformation_gradient(c, x));
         std::array<mesh::Point3, 4> rest;
         for (unsigned int i = 0; i < 4; ++i)
           rest[i] = mesh.vertex(mesh.tet(tets.part(p).tet[c])[i]);
@@ -389,8 +301,6 @@ namespace lacerta::physics
       double          nu = 0.25;
       ParticleRanges  ranges;
       PartitionedTets tets;
-      /// D_m⁻¹ of every copy, entry (r, s) in array 3 r + s, per range.
-      std::vector<std::array<std::vector<double>, 9>> rest_inverse;
       /// λ and μ of every copy (Pa), per range.
       std::vector<std::vector<double>> lambda, mu;
     };

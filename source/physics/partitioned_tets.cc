@@ -87,6 +87,16 @@ namespace lacerta::physics
                     youngs,
                     " Pa at its centroid; Young's modulus must be positive and finite "
                     "on the object.");
+      // D_m⁻¹ = (D_m⁻ᵀ)ᵀ, D_m's columns the edges from vertex 0 (det D_m = 6 V > 0).
+      Matrix3 Dm;
+      for (unsigned int i = 0; i < 3; ++i)
+        for (unsigned int d = 0; d < 3; ++d)
+          Dm[3 * d + i] = mesh.vertex(tet[i + 1])[d] - mesh.vertex(tet[0])[d];
+      const Matrix3 inverse_t = inverse_transpose(Dm, determinant(Dm));
+      Matrix3       rest_inverse;
+      for (unsigned int r = 0; r < 3; ++r)
+        for (unsigned int s = 0; s < 3; ++s)
+          rest_inverse[3 * r + s] = inverse_t[3 * s + r];
       std::array<unsigned int, 4> part_of;
       for (unsigned int i = 0; i < 4; ++i)
         part_of[i] = ranges.part_of(tet[i]);
@@ -109,6 +119,8 @@ namespace lacerta::physics
         part.tet.push_back(t);
         part.rest_volume.push_back(volume);
         part.youngs_modulus.push_back(youngs);
+        for (unsigned int k = 0; k < 9; ++k)
+          part.rest_inverse[k].push_back(rest_inverse[k]);
       }
     }
   }

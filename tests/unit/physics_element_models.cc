@@ -208,10 +208,6 @@ TEST(ElementModels, BoundIsAboveTheTrueFrequencyAndStableAtNinetyPercent)
   for (const std::string &model : element_models)
     for (const double nu : {0.0, 0.25, 0.49})
     {
-      // Volume springs from their lattice ratio (1/4 here) up: below it the volume
-      // term is negative and may make the stiffness indefinite (doc/physics.md).
-      if (model == "volume springs" && nu < 0.25)
-        continue;
       auto system      = test_support::make_system(mesh, 1000, 1e5, 1, model, nu);
       system->position = perturbed(system->rest_position(), 2e-3, 3);
       const std::vector<unsigned int> dofs = free_dofs(*system);
@@ -258,11 +254,14 @@ TEST(ElementModels, BoundIsAboveTheTrueFrequencyAndStableAtNinetyPercent)
 TEST(ElementModels, PulledBarContractsWithTheAskedPoissonRatio)
 {
   // The volume springs with the lattice ratio of box meshes (0.117, measured by
-  // FemAccuracy.PoissonRatioOfFemAndOfSprings); ratios below it are not reached yet.
+  // FemAccuracy.PoissonRatioOfFemAndOfSprings): a shear term below it, a volume term
+  // above.
   const std::vector<std::pair<std::string, std::vector<double>>> cases = {
-    {"volume springs", {0.15, 0.25, 0.35, 0.45, 0.49}},
+    {"volume springs", {0.0, 0.05, 0.15, 0.25, 0.35, 0.45, 0.49}},
     {"corotated fem", {0.0, 0.25, 0.45, 0.49}}};
   for (const auto &[model, ratios] : cases)
+  {
+    double previous = -1;
     for (const double nu : ratios)
     {
       std::ostringstream text;
@@ -273,7 +272,16 @@ TEST(ElementModels, PulledBarContractsWithTheAskedPoissonRatio)
                                               static_displacement(*bar->system));
       std::cout << model << ": asked nu " << nu << ", lateral contraction " << measured
                 << "\n";
-      if (nu <= 0.45)
+      EXPECT_GT(measured, previous) << model << ": " << nu;
+      previous = measured;
+      if (model == "volume springs" && nu < 0.117)
+      {
+        // Below the lattice's ratio the shear term also stiffens the lattice's
+        // non-affine relaxation, which the isotropic derivation does not see: 0.053
+        // at 0 and 0.084 at 0.05 measured (doc/physics.md).
+        EXPECT_NEAR(measured, nu, 0.06) << model;
+      }
+      else if (nu <= 0.45)
       {
         EXPECT_NEAR(measured, nu, 0.03) << model;
       }
@@ -283,6 +291,7 @@ TEST(ElementModels, PulledBarContractsWithTheAskedPoissonRatio)
         EXPECT_TRUE(measured > 0.42 && measured < 0.5) << model << ": " << measured;
       }
     }
+  }
 }
 
 
@@ -367,4 +376,26 @@ TEST(ElementModels, VolumeSpringParametersGiveTheModuliOfTheDerivation)
   // On a lattice of ratio 0.117 the springs keep their shear modulus at that ratio.
   EXPECT_NEAR(physics::volume_spring_parameters(0.117, 0.117).spring_scale, 1.0, 1e-12);
   EXPECT_NEAR(physics::volume_spring_parameters(0.117, 0.117).volume_modulus, 0.0, 1e-12);
+  // Everywhere: the springs (isotropic, of ratio ν_s) plus the term per tetrahedron
+  // have the shear and bulk moduli of (E = 1, ν), and the term only adds stiffness.
+  for (const double lattice : {0.05, 0.117, 0.25})
+    for (const double nu : {0.0, 0.03, 0.1, 0.117, 0.2, 0.25, 0.3, 0.45, 0.49})
+    {
+      const physics::VolumeSpringParameters p =
+        physics::volume_spring_parameters(nu, lattice);
+      const double lattice_shear = 1 / (2 * (1 + lattice));
+      const double lattice_bulk  = 1 / (3 * (1 - 2 * lattice));
+      EXPECT_NEAR(p.spring_scale * lattice_shear + p.shear_modulus,
+                  1 / (2 * (1 + nu)),
+                  1e-12)
+        << nu << ", " << lattice;
+      EXPECT_NEAR(p.spring_scale * lattice_bulk + p.volume_modulus,
+                  1 / (3 * (1 - 2 * nu)),
+                  1e-12)
+        << nu << ", " << lattice;
+      EXPECT_GE(p.volume_modulus, 0) << nu << ", " << lattice;
+      EXPECT_GE(p.shear_modulus, 0) << nu << ", " << lattice;
+      EXPECT_EQ(p.volume_modulus * p.shear_modulus, 0) << nu << ", " << lattice;
+      EXPECT_EQ(p.shear_modulus > 0, nu < lattice) << nu << ", " << lattice;
+    }
 }

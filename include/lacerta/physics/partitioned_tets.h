@@ -4,6 +4,8 @@
  */
 #pragma once
 
+#include <lacerta/physics/matrix3.h>
+
 #include <array>
 #include <vector>
 
@@ -41,6 +43,65 @@ namespace lacerta::physics
       /// Young's modulus at the centroid at rest of every copy (Pa), as the springs
       /// take it (tet_stiffness_factor()).
       std::vector<double> youngs_modulus;
+      /// D_m⁻¹ of every copy (D_m: the edges from local vertex 0 at rest as columns),
+      /// entry (r, s) in array 3 r + s.
+      std::array<std::vector<double>, 9> rest_inverse;
+
+      /// The deformation gradient F = D_s D_m⁻¹ of copy @p c at positions @p x.
+      Matrix3
+      deformation_gradient(const std::size_t c, const double *x) const
+      {
+        const double *x0 = x + 3 * vertex[0][c];
+        Matrix3       Ds;
+        for (unsigned int i = 0; i < 3; ++i)
+        {
+          const double *xi = x + 3 * vertex[i + 1][c];
+          for (unsigned int d = 0; d < 3; ++d)
+            Ds[3 * d + i] = xi[d] - x0[d];
+        }
+        Matrix3 F{};
+        for (unsigned int r = 0; r < 3; ++r)
+          for (unsigned int s = 0; s < 3; ++s)
+            for (unsigned int k = 0; k < 3; ++k)
+              F[3 * r + s] += Ds[3 * r + k] * rest_inverse[3 * k + s][c];
+        return F;
+      }
+
+      /**
+       * The nodal forces of copy @p c under the first Piola–Kirchhoff stress @p P:
+       * -V0 P D_m⁻ᵀ on local vertices 1 to 3 (columns), minus their sum on vertex 0.
+       */
+      void
+      nodal_forces(const std::size_t c, const Matrix3 &P, double (&force)[4][3]) const
+      {
+        for (unsigned int d = 0; d < 3; ++d)
+          force[0][d] = 0;
+        for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int d = 0; d < 3; ++d)
+          {
+            double sum = 0;
+            for (unsigned int k = 0; k < 3; ++k)
+              sum += P[3 * d + k] * rest_inverse[3 * i + k][c];
+            force[i + 1][d] = -rest_volume[c] * sum;
+            force[0][d] -= force[i + 1][d];
+          }
+      }
+
+      /// Adds the nodal forces of copy @p c under stress @p P (nodal_forces()) to
+      /// @p f at the vertices the range owns.
+      void
+      add_owned_nodal_forces(const std::size_t c, const Matrix3 &P, double *f) const
+      {
+        double force[4][3];
+        nodal_forces(c, P, force);
+        for (unsigned int i = 0; i < 4; ++i)
+          if (owned[c] & (1u << i))
+          {
+            double *target = f + 3 * vertex[i][c];
+            for (unsigned int d = 0; d < 3; ++d)
+              target[d] += force[i][d];
+          }
+      }
 
       /// The number of copies.
       std::size_t
@@ -51,10 +112,10 @@ namespace lacerta::physics
     };
 
     /**
-     * Copies the tetrahedra of `system.mesh` into @p ranges, with their rest volumes
-     * and `system.youngs_modulus` at their centroids. Throws an Error naming the
-     * tetrahedron if one is not positively oriented at rest or its modulus is not
-     * positive, and one naming the mismatch if the mesh has no vertex for every
+     * Copies the tetrahedra of `system.mesh` into @p ranges, with their rest volumes,
+     * rest shapes (D_m⁻¹) and `system.youngs_modulus` at their centroids. Throws an Error
+     * naming the tetrahedron if one is not positively oriented at rest or its modulus is
+     * not positive, and one naming the mismatch if the mesh has no vertex for every
      * particle.
      */
     void
