@@ -20,6 +20,8 @@ $SUDO apt-get update
 #  python3-vtk9      the spring-against-FEM render of doc/accuracy.md
 #                    (contrib/figures/render_paper_figures.sh)
 #  clang-14, libclang-rt-14-dev   the sanitizer and fuzzing build (libFuzzer)
+#  libbullet-dev     the optional Bullet peer of the cantilever study
+#                    (-DLACERTA_BULLET_PEER=ON, contrib/peers/bullet/)
 #  xvfb, xauth       a virtual X display: Debian's VTK renders (lacerta-view, the png
 #                    postprocessor) only with an X server, and the tests run under
 #                    xvfb-run
@@ -31,4 +33,5 @@ $SUDO apt-get install -y --no-install-recommends \
   libgtest-dev libbenchmark-dev \
   clang-format python3 python3-matplotlib python3-vtk9 \
   clang-14 libclang-rt-14-dev \
+  libbullet-dev \
   xvfb xauth

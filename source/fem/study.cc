@@ -36,61 +36,12 @@ namespace lacerta::fem
     /// Displacements of a variant at the sample times, 3 per vertex per sample.
     using Samples = std::vector<std::vector<double>>;
 
-    /// The scene of @p prm with its box refined @p factor times and springs as asked.
     /// The force model of a study model of particles.
     std::string
     force_model_of(const std::string &model)
     {
       return model == "volume springs" || model == "corotated fem" ? model
                                                                    : "linear springs";
-    }
-
-
-    std::unique_ptr<scene::Scene>
-    make_scene(dealii::ParameterHandler &prm,
-               const unsigned int        factor,
-               const std::string        &model)
-    {
-      const bool fitted = model == "fitted springs";
-      prm.enter_subsection("Mesh");
-      if (prm.get("Source") != "box")
-        throw_error("Study: 'Refinements' multiply 'Mesh/Box/Repetitions', so the scene "
-                    "must use 'Mesh/Source' = box (it uses '",
-                    prm.get("Source"),
-                    "').");
-      prm.enter_subsection("Box");
-      const std::string base = prm.get("Repetitions");
-      std::string       refined;
-      for (const int n :
-           dealii::Utilities::string_to_int(dealii::Utilities::split_string_list(base)))
-        refined += (refined.empty() ? "" : ", ") + std::to_string(n * factor);
-      prm.set("Repetitions", refined);
-      prm.leave_subsection();
-      prm.leave_subsection();
-      prm.enter_subsection("Material");
-      const std::string stiffness = prm.get("Spring stiffness");
-      prm.set("Spring stiffness", fitted ? "fitted" : "paper");
-      prm.leave_subsection();
-      prm.enter_subsection("Force model");
-      const std::string force_model = prm.get("Model");
-      prm.set("Model", force_model_of(model));
-      prm.leave_subsection();
-
-      auto scene = std::make_unique<scene::Scene>(prm, 1);
-
-      prm.enter_subsection("Force model");
-      prm.set("Model", force_model);
-      prm.leave_subsection();
-
-      prm.enter_subsection("Mesh");
-      prm.enter_subsection("Box");
-      prm.set("Repetitions", base);
-      prm.leave_subsection();
-      prm.leave_subsection();
-      prm.enter_subsection("Material");
-      prm.set("Spring stiffness", stiffness);
-      prm.leave_subsection();
-      return scene;
     }
 
 
@@ -178,6 +129,64 @@ namespace lacerta::fem
       return out.str();
     }
   } // namespace
+
+
+  std::unique_ptr<scene::Scene>
+  make_study_scene(dealii::ParameterHandler &prm,
+                   const unsigned int        factor,
+                   const std::string        &model)
+  {
+    const bool fitted = model == "fitted springs";
+    prm.enter_subsection("Mesh");
+    if (prm.get("Source") != "box")
+      throw_error("Study: 'Refinements' multiply 'Mesh/Box/Repetitions', so the scene "
+                  "must use 'Mesh/Source' = box (it uses '",
+                  prm.get("Source"),
+                  "').");
+    prm.enter_subsection("Box");
+    const std::string base = prm.get("Repetitions");
+    std::string       refined;
+    for (const int n :
+         dealii::Utilities::string_to_int(dealii::Utilities::split_string_list(base)))
+      refined += (refined.empty() ? "" : ", ") + std::to_string(n * factor);
+    prm.set("Repetitions", refined);
+    prm.leave_subsection();
+    prm.leave_subsection();
+    prm.enter_subsection("Material");
+    const std::string stiffness = prm.get("Spring stiffness");
+    prm.set("Spring stiffness", fitted ? "fitted" : "paper");
+    prm.leave_subsection();
+    prm.enter_subsection("Force model");
+    const std::string force_model = prm.get("Model");
+    prm.set("Model", force_model_of(model));
+    prm.leave_subsection();
+
+    auto scene = std::make_unique<scene::Scene>(prm, 1);
+
+    prm.enter_subsection("Force model");
+    prm.set("Model", force_model);
+    prm.leave_subsection();
+
+    prm.enter_subsection("Mesh");
+    prm.enter_subsection("Box");
+    prm.set("Repetitions", base);
+    prm.leave_subsection();
+    prm.leave_subsection();
+    prm.enter_subsection("Material");
+    prm.set("Spring stiffness", stiffness);
+    prm.leave_subsection();
+    return scene;
+  }
+
+
+  SolverParameters
+  study_reference_parameters()
+  {
+    SolverParameters p2;
+    p2.degree    = 2;
+    p2.tolerance = 1e-11;
+    return p2;
+  }
 
 
   void
@@ -309,11 +318,9 @@ namespace lacerta::fem
       sample_times.push_back(end_time);
 
     // The reference: FEM P2 on the refined mesh.
-    auto             reference_scene = make_scene(prm, reference_refinement, "springs");
-    SolverParameters p2;
-    p2.degree    = 2;
-    p2.tolerance = 1e-11;
-    ElasticitySolver        reference_solver(problem_from_scene(*reference_scene), p2);
+    auto reference_scene = make_study_scene(prm, reference_refinement, "springs");
+    ElasticitySolver        reference_solver(problem_from_scene(*reference_scene),
+                                      study_reference_parameters());
     std::vector<NodalField> reference =
       dynamic ? run_newmark(reference_solver, reference_time_step, sample_times)
               : std::vector<NodalField>{reference_solver.solve_static(end_time)};
@@ -354,7 +361,7 @@ namespace lacerta::fem
       for (const std::string &model : models)
       {
         const bool fem   = model.rfind("fem", 0) == 0;
-        auto       scene = make_scene(prm, refinement, model);
+        auto       scene = make_study_scene(prm, refinement, model);
         if (n_frequencies > 0)
         {
           const std::string label = model + " x" + std::to_string(refinement);
@@ -441,7 +448,7 @@ namespace lacerta::fem
             explicit_scheme ? time_steps : std::vector<double>{0.0};
           for (const double dt : steps)
           {
-            auto                     variant = make_scene(prm, refinement, model);
+            auto                     variant = make_study_scene(prm, refinement, model);
             physics::ParticleSystem &system  = *variant->system;
             variant->update_loads(end_time);
             system.enforce_constraints(end_time,

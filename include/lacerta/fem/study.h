@@ -6,13 +6,38 @@
  */
 #pragma once
 
+#include <lacerta/fem/elasticity.h>
+
 #include <deal.II/base/parameter_handler.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
+namespace lacerta::scene
+{
+  class Scene;
+}
+
 namespace lacerta::fem
 {
+  /**
+   * The scene of a study variant: the scene of @p prm with `Mesh/Box/Repetitions`
+   * multiplied by @p factor, and the springs and force model of the study model
+   * @p model ('springs', 'fitted springs', 'volume springs', 'corotated fem'; any other
+   * name gets the paper's springs). @p prm is left as it was. The scene must use the
+   * box source, else an Error.
+   */
+  std::unique_ptr<scene::Scene>
+  make_study_scene(dealii::ParameterHandler &prm,
+                   unsigned int              factor,
+                   const std::string        &model);
+
+  /// The solver of the study's reference: FEM P2, CG to a relative 1e-11.
+  SolverParameters
+  study_reference_parameters();
+
+
   /**
    * One row of the study: a variant, its cost and its error.
    */
