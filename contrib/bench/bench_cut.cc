@@ -13,6 +13,7 @@
 
 #include "bench_support.h"
 #include "benchmark_registry.h"
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -51,13 +52,15 @@ namespace lacerta::bench
 
     /**
      * A slab of n x n x 3 hexahedra (5 tetrahedra each, as the scenes) cut across by
-     * a vertical blade in @p n_steps steps; @p between runs after every cut.
+     * a vertical blade in @p n_steps steps with force model @p model (at ν = 0.45);
+     * @p between runs after every cut.
      */
     Row
     run(const unsigned int n,
         const unsigned int n_steps,
         const bool         partial,
-        const Between      between = Between::relax)
+        const Between      between = Between::relax,
+        const std::string &model   = "linear springs")
     {
       dealii::Triangulation<3> tria;
       dealii::GridGenerator::subdivided_hyper_rectangle_with_simplices(
@@ -71,6 +74,13 @@ namespace lacerta::bench
       const auto               particles = make_particle_system(mesh, density, youngs);
       physics::ParticleSystem &system    = *particles;
       double                   integral  = physics::integrate_over_mesh(mesh, density);
+      if (model != "linear springs")
+      {
+        system.mesh           = &mesh;
+        system.youngs_modulus = &youngs;
+        system.poisson_ratio  = 0.45;
+        system.set_force_model(physics::ForceModelRegistry::create(model), 1);
+      }
       std::unique_ptr<physics::Integrator> rk4 =
         physics::IntegratorRegistry::create("rk4");
       rk4->initialize(system);
@@ -133,12 +143,13 @@ namespace lacerta::bench
     best_of_three(const unsigned int n,
                   const unsigned int n_steps,
                   const bool         partial,
-                  const Between      between = Between::relax)
+                  const Between      between = Between::relax,
+                  const std::string &model   = "linear springs")
     {
-      Row best = run(n, n_steps, partial, between);
+      Row best = run(n, n_steps, partial, between, model);
       for (unsigned int k = 1; k < 3; ++k)
       {
-        const Row r = run(n, n_steps, partial, between);
+        const Row r = run(n, n_steps, partial, between, model);
         if (r.update_ms < best.update_ms)
           best = r;
       }
@@ -187,7 +198,7 @@ namespace lacerta::bench
     int
     bench_cut(const std::vector<std::string> &arguments)
     {
-      if (arguments.size() >= 2 && arguments.size() <= 4)
+      if (arguments.size() >= 2 && arguments.size() <= 5)
       {
         // One stroke (for profilers and for the cache study): n, steps, and
         // optionally "partial" and what runs between the cuts.
@@ -196,10 +207,18 @@ namespace lacerta::bench
         bool               partial = false, between_given = false;
         bool               valid   = n >= 1 && n <= 200 && steps >= 1 && steps <= 100000;
         Between            between = Between::relax;
+        std::string        model   = "linear springs";
         for (std::size_t i = 2; i < arguments.size(); ++i)
         {
           const std::string &a = arguments[i];
-          if (a == "partial" && !partial)
+          if (a.rfind("model=", 0) == 0 && model == "linear springs")
+          {
+            // model=volume_springs, model=corotated_fem: underscores for spaces.
+            model = a.substr(6);
+            std::replace(model.begin(), model.end(), '_', ' ');
+            valid &= physics::ForceModelRegistry::plugins().count(model) > 0;
+          }
+          else if (a == "partial" && !partial)
             partial = true;
           else if ((a == "relax" || a == "nothing" || a == "flush") && !between_given)
           {
@@ -217,10 +236,11 @@ namespace lacerta::bench
                        "lacerta-bench cut: expected n (1-200), steps (1-100000), "
                        "optionally 'partial', and optionally what runs between the "
                        "cuts: 'relax' (an RK4 step, the default), 'nothing' or "
-                       "'flush' (64 MiB through the cache)\n");
+                       "'flush' (64 MiB through the cache), and optionally "
+                       "'model=NAME' (a force model, '_' for spaces)\n");
           return 1;
         }
-        const Row r = best_of_three(n, steps, partial, between);
+        const Row r = best_of_three(n, steps, partial, between, model);
         std::printf(
           "%8s %8s %8s %10s %10s %10s\n", "MS", "CuT", "CrT", "UpdT", "ReinitT", "RxT");
         print(r);
@@ -232,7 +252,7 @@ namespace lacerta::bench
       {
         std::fprintf(stderr,
                      "lacerta-bench cut: expected no argument, or n steps [partial] "
-                     "[relax|nothing|flush]\n");
+                     "[relax|nothing|flush] [model=NAME]\n");
         return 1;
       }
       std::printf("Table 1 (averages over the steps that cut, the run with the least "
@@ -267,9 +287,10 @@ namespace lacerta::bench
                              "the paper's Table 1: mesh size, tetrahedra cut and created "
                              "per step, mesh update and relaxation time; update time "
                              "against cut size and mesh size, per phase (arguments: "
-                             "none, or n steps [partial] [relax|nothing|flush] for one "
-                             "stroke across a slab of n x n x 3 x 5 tetrahedra, with an "
-                             "RK4 step, nothing, or 64 MiB of memory traffic between "
-                             "the cuts)",
+                             "none, or n steps [partial] [relax|nothing|flush] "
+                             "[model=NAME] for one stroke across a slab of n x n x 3 x 5 "
+                             "tetrahedra, with an RK4 step, nothing, or 64 MiB of memory "
+                             "traffic between the cuts, and force model NAME, '_' for "
+                             "spaces)",
                              bench_cut);
 } // namespace lacerta::bench

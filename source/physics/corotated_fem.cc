@@ -83,8 +83,9 @@ namespace lacerta::physics
      *
      * Per-tetrahedron data are structures of arrays per thread range (PartitionedTets):
      * each range evaluates the tetrahedra touching it and writes its own vertices
-     * only. After a cut or a tear the tetrahedra are copied again from the mesh:
-     * O(tetrahedra) per change.
+     * only. After a cut or a tear the copies of the changed tetrahedra are replaced
+     * (PartitionedTets::update()); the ranges are split again only when appended
+     * particles have unbalanced them.
      */
     class CorotatedFem : public ForceModel
     {
@@ -97,17 +98,31 @@ namespace lacerta::physics
       void
       initialize(const ParticleSystem &system, const unsigned int n_threads) override
       {
-        nu = checked_poisson_ratio(system, "corotated fem");
+        nu                               = checked_poisson_ratio(system, "corotated fem");
+        const std::array<double, 2> lame = lame_parameters(1.0, nu);
+        lambda_per_modulus               = lame[0];
+        mu_per_modulus                   = lame[1];
         ranges.split(system, PartitionedTets::tets_per_particle(system), n_threads);
-        copy_tets(system);
+        tets.build(system, ranges);
       }
 
       void
-      springs_changed(const ParticleSystem &system,
-                      const std::vector<unsigned int> &) override
+      springs_changed(const ParticleSystem            &system,
+                      const std::vector<unsigned int> &changed) override
       {
-        // New particles, new masses and new tetrahedra: everything is read again.
-        initialize(system, ranges.threads());
+        // New particles join the last range; the masses of the changed springs' ends
+        // and the copies of the changed tetrahedra are read again.
+        ranges.append_particles(system);
+        const std::size_t n_springs = system.springs.size();
+        for (const unsigned int s : changed)
+          if (s < n_springs)
+          {
+            ranges.update_inverse_mass(system, system.springs.a[s]);
+            ranges.update_inverse_mass(system, system.springs.b[s]);
+          }
+        tets.update(system, ranges, changed);
+        if (tets.unbalanced())
+          initialize(system, ranges.threads());
       }
 
       void
@@ -160,8 +175,9 @@ namespace lacerta::physics
                 stretch += (F[k] - R[k]) * (F[k] - R[k]);
               for (unsigned int k = 0; k < 9; ++k)
                 trace += R[k] * F[k];
-              energy += part.rest_volume[c]
-                        * (mu[p][c] * stretch + 0.5 * lambda[p][c] * trace * trace);
+              energy +=
+                part.rest_volume[c] * part.youngs_modulus[c]
+                * (mu_per_modulus * stretch + 0.5 * lambda_per_modulus * trace * trace);
             }
         }
         return energy;
@@ -190,26 +206,6 @@ namespace lacerta::physics
       }
 
     private:
-      /// Copies the tetrahedra into the ranges with λ and μ of each copy.
-      void
-      copy_tets(const ParticleSystem &system)
-      {
-        tets.build(system, ranges);
-        const unsigned int n = ranges.n_parts();
-        lambda.assign(n, {});
-        mu.assign(n, {});
-        for (unsigned int p = 0; p < n; ++p)
-        {
-          const PartitionedTets::Part &part = tets.part(p);
-          for (const double youngs : part.youngs_modulus)
-          {
-            const auto [l, m] = lame_parameters(youngs, nu);
-            lambda[p].push_back(l);
-            mu[p].push_back(m);
-          }
-        }
-      }
-
       /**
        * The stress P of copy @p c: 2μ (F - R) + λ tr(RᵀF - I) R, plus with β > 0 the
        * damping stress β R (2μ sym(RᵀḞ) + λ tr(RᵀḞ) I).
@@ -221,9 +217,10 @@ namespace lacerta::physics
              const double      *v,
              const double       beta) const
       {
-        const Matrix3 F = tets.part(p).deformation_gradient(c, x);
-        const Matrix3 R = rotation_of(F);
-        const double  l = lambda[p][c], m = mu[p][c];
+        const Matrix3 F      = tets.part(p).deformation_gradient(c, x);
+        const Matrix3 R      = rotation_of(F);
+        const double  youngs = tets.part(p).youngs_modulus[c];
+        const double  l = lambda_per_modulus * youngs, m = mu_per_modulus * youngs;
         double        trace = -3;
         for (unsigned int k = 0; k < 9; ++k)
           trace += R[k] * F[k];
@@ -282,7 +279,9 @@ namespace lacerta::physics
         for (unsigned int i = 0; i < 4; ++i)
           rest[i] = mesh.vertex(mesh.tet(tets.part(p).tet[c])[i]);
         const dealii::FullMatrix<double> K =
-          p1_element_stiffness(rest, lambda[p][c], mu[p][c]);
+          p1_element_stiffness(rest,
+                               lambda_per_modulus * tets.part(p).youngs_modulus[c],
+                               mu_per_modulus * tets.part(p).youngs_modulus[c]);
         ElementStiffness rotated{};
         for (unsigned int a = 0; a < 4; ++a)
           for (unsigned int b = 0; b < 4; ++b)
@@ -301,8 +300,8 @@ namespace lacerta::physics
       double          nu = 0.25;
       ParticleRanges  ranges;
       PartitionedTets tets;
-      /// λ and μ of every copy (Pa), per range.
-      std::vector<std::vector<double>> lambda, mu;
+      /// λ / E and μ / E at the Poisson ratio (λ and μ are linear in E).
+      double lambda_per_modulus = 0, mu_per_modulus = 0;
     };
   } // namespace
 

@@ -85,8 +85,8 @@ namespace lacerta::physics
      * also evaluates the tetrahedra that touch it (PartitionedTets) and adds their
      * forces to its own vertices only.
      *
-     * After a cut or a tear the springs are updated locally (LinearSprings) but the
-     * tetrahedra are copied again from the mesh: O(tetrahedra) per change.
+     * After a cut or a tear the springs and the copies of the changed tetrahedra are
+     * updated locally (LinearSprings, PartitionedTets::update()).
      */
     class VolumeSprings : public LinearSprings
     {
@@ -126,8 +126,20 @@ namespace lacerta::physics
       springs_changed(const ParticleSystem            &system,
                       const std::vector<unsigned int> &changed) override
       {
+        // The springs may split their ranges again (when appended particles have
+        // unbalanced them); then every tetrahedron is copied again, else only the
+        // changed ones.
+        range_starts.clear();
+        for (unsigned int p = 0; p < ranges.n_parts(); ++p)
+          range_starts.push_back(ranges.begin(p));
         LinearSprings::springs_changed(system, changed);
-        tets.build(system, ranges);
+        bool same_ranges = range_starts.size() == ranges.n_parts();
+        for (unsigned int p = 0; same_ranges && p < ranges.n_parts(); ++p)
+          same_ranges = range_starts[p] == ranges.begin(p);
+        if (same_ranges)
+          tets.update(system, ranges, changed);
+        else
+          tets.build(system, ranges);
       }
 
       void
@@ -411,6 +423,8 @@ namespace lacerta::physics
       double                 lattice_nu = 0.25;
       VolumeSpringParameters parameters;
       PartitionedTets        tets;
+      /// The first particle of every range before a local change (scratch).
+      std::vector<unsigned int> range_starts;
     };
   } // namespace
 

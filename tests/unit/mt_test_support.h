@@ -23,17 +23,20 @@ namespace lacerta::test_support
 {
   /**
    * The scene of a parameter file whose text is @p parameters, written to a temporary
-   * file @p name (so that its `include` lines resolve as a scene file's) and removed.
+   * file @p name (so that its `include` lines resolve as a scene file's) and removed,
+   * its force model on @p n_threads threads.
    */
   inline std::unique_ptr<scene::Scene>
-  scene_from_text(const std::string &name, const std::string &parameters)
+  scene_from_text(const std::string &name,
+                  const std::string &parameters,
+                  const unsigned int n_threads = 1)
   {
     const std::string file = (std::filesystem::temp_directory_path() / name).string();
     std::ofstream(file) << parameters;
     dealii::ParameterHandler prm;
     Simulator::read_parameters(file, prm);
     std::filesystem::remove(file);
-    return std::make_unique<scene::Scene>(prm, 1);
+    return std::make_unique<scene::Scene>(prm, n_threads);
   }
 
 

@@ -297,56 +297,61 @@ TEST(ElementModels, PulledBarContractsWithTheAskedPoissonRatio)
 
 TEST(ElementModels, RunThroughACutAndStayAtRestThere)
 {
+  // The model follows the cut locally (PartitionedTets::update()), on one range and
+  // on two (the new particles join the last range).
   for (const std::string &model : element_models)
-  {
-    std::ostringstream text;
-    text << "include " LACERTA_SCENE_DIR "/square_lod.prm\n"
-         << "subsection Mesh\n  subsection Box\n    set Repetitions = 6, 6, 2\n"
-         << "  end\nend\n"
-         << "subsection Multiresolution\n  set Enabled = false\nend\n"
-         << "subsection Material\n  set Poisson ratio = 0.4\nend\n"
-         << "subsection Force model\n  set Model = " << model << "\nend\n"
-         << "subsection Tool\n  set Type = scalpel\n  subsection Scalpel\n"
-         << "    set Keyframes = 0, 0.003, 0.07, 0.03, 0.003, 0.07, -0.01; "
-            "1, 0.003, -0.07, 0.03, 0.003, -0.07, -0.01\n  end\nend\n";
-    auto scene = test_support::scene_from_text("lacerta_element_cut.prm", text.str());
-    physics::ParticleSystem &system = *scene->system;
-    const unsigned int       before = scene->mesh.n_tets();
-    for (unsigned int k = 1; k <= 20; ++k)
-      scene->cut(scene->tool->blade(k / 20.0), 0.01 * k);
-    ASSERT_GT(scene->mesh.n_tets(), before) << model;
-    ASSERT_EQ(system.n_particles(), scene->mesh.n_vertices()) << model;
-
-    // At rest (the rest positions of every particle, new ones included): no force.
-    const double scale =
-      largest_magnitude(forces_at(system, perturbed(system.rest_position(), 1e-4, 9)));
-    EXPECT_LT(largest_magnitude(forces_at(system, system.rest_position())), 1e-9 * scale)
-      << model;
-    // The model after the cut is the model made afresh on the cut mesh.
-    auto fresh = physics::ForceModelRegistry::create(model);
-    fresh->initialize(system, 1);
-    const std::vector<double> x = perturbed(system.position, 1e-3, 4);
-    std::vector<double>       v(x.size(), 0.0), theirs(x.size());
-    fresh->compute_spring_forces(system, x.data(), v.data(), theirs.data());
-    const auto mine = forces_at(system, x);
-    for (std::size_t c = 0; c < x.size(); ++c)
-      EXPECT_NEAR(mine[c], theirs[c], 1e-12 * largest_magnitude(theirs)) << model;
-
-    // And it runs, below its bound, with the blow-up monitor watching.
-    const auto integrator = physics::IntegratorRegistry::create("velocity_verlet");
-    integrator->initialize(system);
-    const double dt =
-      0.9
-      * integrator->critical_time_step(physics::bound_highest_frequency(system).omega,
-                                       system.mass_damping,
-                                       system.spring_damping);
-    physics::BlowUpMonitor monitor(system, 1.0);
-    for (unsigned int step = 1; step <= 200; ++step)
+    for (const unsigned int threads : {1u, 2u})
     {
-      integrator->step(system, step * dt, dt);
-      EXPECT_NO_THROW(monitor.check(system, step, step * dt)) << model;
+      std::ostringstream text;
+      text << "include " LACERTA_SCENE_DIR "/square_lod.prm\n"
+           << "subsection Mesh\n  subsection Box\n    set Repetitions = 6, 6, 2\n"
+           << "  end\nend\n"
+           << "subsection Multiresolution\n  set Enabled = false\nend\n"
+           << "subsection Material\n  set Poisson ratio = 0.4\nend\n"
+           << "subsection Force model\n  set Model = " << model << "\nend\n"
+           << "subsection Tool\n  set Type = scalpel\n  subsection Scalpel\n"
+           << "    set Keyframes = 0, 0.003, 0.07, 0.03, 0.003, 0.07, -0.01; "
+              "1, 0.003, -0.07, 0.03, 0.003, -0.07, -0.01\n  end\nend\n";
+      auto scene =
+        test_support::scene_from_text("lacerta_element_cut.prm", text.str(), threads);
+      physics::ParticleSystem &system = *scene->system;
+      const unsigned int       before = scene->mesh.n_tets();
+      for (unsigned int k = 1; k <= 20; ++k)
+        scene->cut(scene->tool->blade(k / 20.0), 0.01 * k);
+      ASSERT_GT(scene->mesh.n_tets(), before) << model;
+      ASSERT_EQ(system.n_particles(), scene->mesh.n_vertices()) << model;
+
+      // At rest (the rest positions of every particle, new ones included): no force.
+      const double scale =
+        largest_magnitude(forces_at(system, perturbed(system.rest_position(), 1e-4, 9)));
+      EXPECT_LT(largest_magnitude(forces_at(system, system.rest_position())),
+                1e-9 * scale)
+        << model;
+      // The model after the cut is the model made afresh on the cut mesh.
+      auto fresh = physics::ForceModelRegistry::create(model);
+      fresh->initialize(system, threads);
+      const std::vector<double> x = perturbed(system.position, 1e-3, 4);
+      std::vector<double>       v(x.size(), 0.0), theirs(x.size());
+      fresh->compute_spring_forces(system, x.data(), v.data(), theirs.data());
+      const auto mine = forces_at(system, x);
+      for (std::size_t c = 0; c < x.size(); ++c)
+        EXPECT_NEAR(mine[c], theirs[c], 1e-12 * largest_magnitude(theirs)) << model;
+
+      // And it runs, below its bound, with the blow-up monitor watching.
+      const auto integrator = physics::IntegratorRegistry::create("velocity_verlet");
+      integrator->initialize(system);
+      const double dt =
+        0.9
+        * integrator->critical_time_step(physics::bound_highest_frequency(system).omega,
+                                         system.mass_damping,
+                                         system.spring_damping);
+      physics::BlowUpMonitor monitor(system, 1.0);
+      for (unsigned int step = 1; step <= 200; ++step)
+      {
+        integrator->step(system, step * dt, dt);
+        EXPECT_NO_THROW(monitor.check(system, step, step * dt)) << model;
+      }
     }
-  }
 }
 
 

@@ -24,7 +24,8 @@ namespace lacerta::physics
    * of its vertices, as a structure of arrays per range: the thread of a range
    * evaluates its copies and adds forces only to the vertices it owns (`owned`), so a
    * tetrahedron across ranges is evaluated once per range and no thread writes
-   * another's memory. Copies keep the order of the mesh's tetrahedra.
+   * another's memory. build() copies in the order of the mesh's tetrahedra; update()
+   * replaces the copies of the tetrahedra a cut or a tear changed, locally.
    */
   class PartitionedTets
   {
@@ -121,6 +122,31 @@ namespace lacerta::physics
     void
     build(const ParticleSystem &system, const ParticleRanges &ranges);
 
+    /**
+     * The mesh changed locally since the last build() or update() (a cut, a tear):
+     * every tetrahedron that changed has a vertex that is an end of one of the
+     * springs @p changed (indices into `system.springs`; a changed tetrahedron
+     * changes the stiffness of its edges' springs) or is appended. Replaces the copies
+     * of every such tetrahedron whose vertices are not those copied, and copies the
+     * appended ones; the ranges must be those of the last build() with the new
+     * particles appended to the last range. Costs O(changed tetrahedra of the stars
+     * of the springs' ends), not O(mesh). Throws as build() does. The copies are then
+     * those build() would make, in another order (a removed copy's hole takes its
+     * range's last copy, new copies are appended), so forces summed over them agree
+     * with a fresh build() to rounding, not to the bit.
+     */
+    void
+    update(const ParticleSystem            &system,
+           const ParticleRanges            &ranges,
+           const std::vector<unsigned int> &changed);
+
+    /**
+     * Whether the copies are spread so unevenly over the ranges (appended particles
+     * join the last range) that the ranges should be split again.
+     */
+    bool
+    unbalanced() const;
+
     /// The copies of range @p p.
     const Part &
     part(const unsigned int p) const
@@ -133,7 +159,35 @@ namespace lacerta::physics
     tets_per_particle(const ParticleSystem &system);
 
   private:
+    /// Where a copy is: its range and its index there.
+    struct CopyRef
+    {
+      unsigned int part  = invalid;
+      unsigned int index = invalid;
+    };
+    static constexpr unsigned int invalid = static_cast<unsigned int>(-1);
+
+    /// Copies tetrahedron @p t of @p mesh into the ranges owning its vertices.
+    void
+    add_copies(const ParticleSystem &system,
+               const ParticleRanges &ranges,
+               unsigned int          t);
+
+    /// Removes every copy of tetrahedron @p t (the last copy of its range moves into
+    /// the hole).
+    void
+    remove_copies(unsigned int t);
+
+    /// Whether the copies of @p t are of the mesh's tetrahedron @p t as it is now.
+    bool
+    copied_as_is(const ParticleSystem &system, unsigned int t) const;
+
     std::vector<Part> parts;
+    /// The copies of every tetrahedron (at most one per range, four ranges at most).
+    std::vector<std::array<CopyRef, 4>> copies;
+    /// Per tetrahedron, the update() that last saw it (no tetrahedron visited twice).
+    std::vector<unsigned int> seen;
+    unsigned int              update_count = 0;
   };
 
   /**
