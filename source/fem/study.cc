@@ -12,6 +12,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/utilities.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -127,6 +128,119 @@ namespace lacerta::fem
       std::ostringstream out;
       out << std::setprecision(6) << value;
       return out.str();
+    }
+
+
+    /// The lowest frequencies at 4 digits: the subspace iteration converges to far
+    /// better than that, so the printout is the same on any number of ranks.
+    void
+    print_frequencies(std::ostream              &out,
+                      const std::string         &label,
+                      const std::vector<double> &frequencies)
+    {
+      out << "  frequencies [Hz] " << std::left << std::setw(27) << label
+          << std::setprecision(4);
+      for (const double f : frequencies)
+        out << ' ' << f;
+      out << std::setprecision(6) << "\n";
+    }
+
+
+    /// The variant's name in study.csv, blanks as underscores; @p nu < 0: not named.
+    std::string
+    variant_name(const std::string &model,
+                 const unsigned int refinement,
+                 const std::string &integrator,
+                 const double       dt,
+                 const double       nu)
+    {
+      std::string name = model + " x" + std::to_string(refinement) + " " + integrator;
+      if (dt > 0)
+        name += " dt=" + format(dt);
+      if (nu >= 0)
+        name += " nu=" + format(nu);
+      for (char &c : name)
+        if (c == ' ')
+          c = '_';
+      return name;
+    }
+
+
+    void
+    print_row(std::ostream &out, const StudyRow &row, const bool test_mode)
+    {
+      out << "  " << std::left << std::setw(44) << row.variant << " tets " << std::setw(7)
+          << row.tets << " error L2 " << std::setw(10) << format(row.error_l2) << " max "
+          << std::setw(10) << format(row.error_max);
+      if (!test_mode)
+        out << " wall " << format(row.wall_time) << " s";
+      out << "\n";
+    }
+
+
+    /// A variant's samples and the wall time it took to compute them.
+    struct TimedSamples
+    {
+      Samples samples;
+      double  seconds = 0;
+    };
+
+
+    /// FEM of degree @p degree on @p scene: static (dt = 0) or Newmark with step dt,
+    /// timed from the solver's set-up on.
+    TimedSamples
+    run_fem(scene::Scene              &scene,
+            const unsigned int         degree,
+            const double               dt,
+            const std::vector<double> &sample_times)
+    {
+      SolverParameters parameters;
+      parameters.degree = degree;
+      MPI_Barrier(MPI_COMM_WORLD);
+      const auto              start = Clock::now();
+      ElasticitySolver        solver(problem_from_scene(scene), parameters);
+      std::vector<NodalField> fields =
+        dt > 0 ? run_newmark(solver, dt, sample_times)
+               : std::vector<NodalField>{solver.solve_static(sample_times.back())};
+      TimedSamples timed;
+      timed.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+      for (const auto &field : fields)
+        timed.samples.push_back(field.vertex);
+      return timed;
+    }
+
+
+    /// A particle model on @p scene by @p integrator: 'direct' and 'relaxation' from
+    /// the prescribed particles at the last sample time, an explicit integrator with
+    /// step dt from rest; timed from the built scene on.
+    TimedSamples
+    run_particles(dealii::ParameterHandler  &prm,
+                  scene::Scene              &scene,
+                  const std::string         &integrator,
+                  const double               dt,
+                  const std::vector<double> &sample_times)
+    {
+      physics::ParticleSystem &system   = *scene.system;
+      const double             end_time = sample_times.back();
+      scene.update_loads(end_time);
+      system.enforce_constraints(end_time,
+                                 system.position.data(),
+                                 system.velocity.data());
+      const auto   start = Clock::now();
+      TimedSamples timed;
+      if (integrator == "direct")
+        timed.samples.push_back(solve_linearised_springs(system));
+      else if (integrator == "relaxation")
+        timed.samples.push_back(relax_springs(system).displacement);
+      else
+      {
+        system.position = system.rest_position();
+        std::fill(system.velocity.begin(), system.velocity.end(), 0.0);
+        system.enforce_constraints(0, system.position.data(), system.velocity.data());
+        timed.samples = run_explicit(prm, scene, integrator, dt, sample_times);
+      }
+      timed.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+      return timed;
     }
   } // namespace
 
@@ -250,6 +364,14 @@ namespace lacerta::fem
                       "vertices held) to print for the reference and for every model "
                       "and refinement: the springs linearised at rest against FEM. "
                       "0: none.");
+    prm.declare_entry(
+      "Poisson ratios",
+      "",
+      dealii::Patterns::List(dealii::Patterns::Double(0.0, 0.499), 0, 16, ","),
+      "Run every variant and the reference at each of these Poisson ratios in turn, in "
+      "place of 'Material/Poisson ratio' (the same range), the reference recomputed "
+      "for each; study.csv's column poisson_ratio and one panel of study.png per "
+      "ratio. Empty: the scene's 'Material/Poisson ratio' only.");
     prm.declare_entry("Plot",
                       "true",
                       dealii::Patterns::Bool(),
@@ -281,9 +403,18 @@ namespace lacerta::fem
     reference_time_step  = prm.get_double("Reference time step");
     n_samples            = prm.get_integer("Number of samples");
     n_frequencies        = prm.get_integer("Number of frequencies");
-    plot                 = prm.get_bool("Plot");
-    plot_script          = prm.get("Plot script");
+    poisson_ratios       = dealii::Utilities::string_to_double(
+      dealii::Utilities::split_string_list(prm.get("Poisson ratios")));
+    plot        = prm.get_bool("Plot");
+    plot_script = prm.get("Plot script");
     prm.leave_subsection();
+
+    const double end_time = prm.get_double("End time");
+    if (dynamic)
+      for (unsigned int k = 1; k <= n_samples; ++k)
+        sample_times.push_back(end_time * k / n_samples);
+    else
+      sample_times.push_back(end_time);
 
     const double scene_step = prm.get_double("Time step");
     for (double &dt : time_steps)
@@ -302,209 +433,190 @@ namespace lacerta::fem
   }
 
 
+  struct Study::Reference
+  {
+    std::unique_ptr<scene::Scene> scene;
+    std::vector<NodalField>       fields;
+  };
+
+
   std::vector<StudyRow>
   Study::run()
   {
     const bool    root = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
     std::ostream  null_stream(nullptr);
-    std::ostream &out      = root ? std::cout : null_stream;
-    const double  end_time = prm.get_double("End time");
+    std::ostream &out = root ? std::cout : null_stream;
 
-    std::vector<double> sample_times;
-    if (dynamic)
-      for (unsigned int k = 1; k <= n_samples; ++k)
-        sample_times.push_back(end_time * k / n_samples);
-    else
-      sample_times.push_back(end_time);
+    prm.enter_subsection("Material");
+    const std::string scene_ratio = prm.get("Poisson ratio");
+    const double      scene_nu    = prm.get_double("Poisson ratio");
+    prm.leave_subsection();
+    std::vector<StudyRow> rows;
+    for (const double nu :
+         poisson_ratios.empty() ? std::vector<double>{scene_nu} : poisson_ratios)
+    {
+      prm.enter_subsection("Material");
+      prm.set("Poisson ratio", nu);
+      prm.leave_subsection();
+      const std::vector<StudyRow> at_nu = run_at_poisson_ratio(nu, out);
+      rows.insert(rows.end(), at_nu.begin(), at_nu.end());
+    }
+    prm.enter_subsection("Material");
+    prm.set("Poisson ratio", scene_ratio);
+    prm.leave_subsection();
 
-    // The reference: FEM P2 on the refined mesh.
-    auto reference_scene = make_study_scene(prm, reference_refinement, "springs");
-    ElasticitySolver        reference_solver(problem_from_scene(*reference_scene),
+    if (root)
+      write_results(rows, out);
+    return rows;
+  }
+
+
+  std::vector<StudyRow>
+  Study::run_at_poisson_ratio(const double nu, std::ostream &out)
+  {
+    const double end_time = sample_times.back();
+    Reference    reference;
+    reference.scene = make_study_scene(prm, reference_refinement, "springs");
+    ElasticitySolver reference_solver(problem_from_scene(*reference.scene),
                                       study_reference_parameters());
-    std::vector<NodalField> reference =
+    reference.fields =
       dynamic ? run_newmark(reference_solver, reference_time_step, sample_times)
               : std::vector<NodalField>{reference_solver.solve_static(end_time)};
     out << "Study: " << (dynamic ? "dynamic" : "static")
-        << " analysis; reference FEM P2 on " << reference_scene->mesh.n_tets()
+        << " analysis; reference FEM P2 on " << reference.scene->mesh.n_tets()
         << " tetrahedra, " << reference_solver.n_dofs() << " dofs"
         << (dynamic ? ", Newmark time step " + format(reference_time_step) + " s" : "")
-        << "\n";
+        << (poisson_ratios.empty() ? "" : ", Poisson ratio " + format(nu)) << "\n";
     // To solver tolerance, whatever the number of MPI ranks (a regression test runs
     // this on one and on two).
     double largest = 0;
-    for (const auto &field : reference)
-      for (unsigned int v = 0; v < reference_scene->mesh.n_vertices(); ++v)
+    for (const auto &field : reference.fields)
+      for (unsigned int v = 0; v < reference.scene->mesh.n_vertices(); ++v)
         largest = std::max(largest,
                            std::sqrt(field.at_vertex(v)[0] * field.at_vertex(v)[0]
                                      + field.at_vertex(v)[1] * field.at_vertex(v)[1]
                                      + field.at_vertex(v)[2] * field.at_vertex(v)[2]));
     out << "Reference: largest vertex displacement " << std::setprecision(9) << largest
         << " m" << std::setprecision(6) << "\n";
-
-    // Frequencies at 4 digits: the subspace iteration converges to far better than
-    // that, so the printout is the same on any number of ranks.
-    const auto print_frequencies =
-      [&](const std::string &label, const std::vector<double> &frequencies)
-    {
-      out << "  frequencies [Hz] " << std::left << std::setw(27) << label
-          << std::setprecision(4);
-      for (const double f : frequencies)
-        out << ' ' << f;
-      out << std::setprecision(6) << "\n";
-    };
     if (n_frequencies > 0)
-      print_frequencies("reference fem p2",
+      print_frequencies(out,
+                        "reference fem p2",
                         reference_solver.lowest_frequencies(n_frequencies));
 
     std::vector<StudyRow> rows;
     for (const unsigned int refinement : refinements)
       for (const std::string &model : models)
       {
-        const bool fem   = model.rfind("fem", 0) == 0;
-        auto       scene = make_study_scene(prm, refinement, model);
-        if (n_frequencies > 0)
-        {
-          const std::string label = model + " x" + std::to_string(refinement);
-          if (fem)
-          {
-            SolverParameters parameters;
-            parameters.degree = model == "fem p2" ? 2 : 1;
-            print_frequencies(label,
-                              ElasticitySolver(problem_from_scene(*scene), parameters)
-                                .lowest_frequencies(n_frequencies));
-          }
-          else
-            print_frequencies(label, spring_frequencies(*scene->system, n_frequencies));
-        }
-        const auto                            &vertices = scene->mesh.get_vertices();
-        std::vector<std::vector<mesh::Point3>> expected;
-        for (const auto &field : reference)
-          expected.push_back(evaluate(reference_scene->mesh, field, vertices));
-
-        const auto add_row = [&](const std::string &integrator,
-                                 const double       dt,
-                                 const double       seconds,
-                                 const Samples     &samples)
-        {
-          NodalError error;
-          for (std::size_t s = 0; s < samples.size(); ++s)
-            error.add(nodal_error(samples[s], expected[s]));
-          StudyRow row;
-          row.model        = model;
-          row.integrator   = integrator;
-          row.tets         = scene->mesh.n_tets();
-          row.time_step    = dt;
-          row.wall_time    = seconds;
-          row.error_l2     = error.relative_l2();
-          row.error_max    = error.relative_max();
-          std::string name = model + " x" + std::to_string(refinement) + " " + integrator;
-          if (dt > 0)
-            name += " dt=" + format(dt);
-          for (char &c : name)
-            if (c == ' ')
-              c = '_';
-          row.variant = name;
-          rows.push_back(row);
-          out << "  " << std::left << std::setw(44) << row.variant << " tets "
-              << std::setw(7) << row.tets << " error L2 " << std::setw(10)
-              << format(row.error_l2) << " max " << std::setw(10)
-              << format(row.error_max);
-          if (!test_mode)
-            out << " wall " << format(row.wall_time) << " s";
-          out << "\n";
-        };
-
-        if (fem)
-        {
-          SolverParameters parameters;
-          parameters.degree = model == "fem p2" ? 2 : 1;
-          const std::vector<double> steps =
-            dynamic ? time_steps : std::vector<double>{0.0};
-          for (const double dt : steps)
-          {
-            MPI_Barrier(MPI_COMM_WORLD);
-            const auto              start = Clock::now();
-            ElasticitySolver        solver(problem_from_scene(*scene), parameters);
-            std::vector<NodalField> fields =
-              dynamic ? run_newmark(solver, dt, sample_times)
-                      : std::vector<NodalField>{solver.solve_static(end_time)};
-            const double seconds =
-              std::chrono::duration<double>(Clock::now() - start).count();
-            Samples samples;
-            for (const auto &field : fields)
-              samples.push_back(field.vertex);
-            add_row(dynamic ? "newmark" : "cg-amg", dt, seconds, samples);
-          }
-          continue;
-        }
-
-        for (const std::string &integrator : integrators)
-        {
-          const bool explicit_scheme =
-            integrator != "direct" && integrator != "relaxation";
-          if (dynamic && !explicit_scheme)
-            continue;
-          const std::vector<double> steps =
-            explicit_scheme ? time_steps : std::vector<double>{0.0};
-          for (const double dt : steps)
-          {
-            auto                     variant = make_study_scene(prm, refinement, model);
-            physics::ParticleSystem &system  = *variant->system;
-            variant->update_loads(end_time);
-            system.enforce_constraints(end_time,
-                                       system.position.data(),
-                                       system.velocity.data());
-            const auto start = Clock::now();
-            Samples    samples;
-            if (integrator == "direct")
-              samples.push_back(solve_linearised_springs(system));
-            else if (integrator == "relaxation")
-              samples.push_back(relax_springs(system).displacement);
-            else
-            {
-              system.position = system.rest_position();
-              std::fill(system.velocity.begin(), system.velocity.end(), 0.0);
-              system.enforce_constraints(0,
-                                         system.position.data(),
-                                         system.velocity.data());
-              samples = run_explicit(prm, *variant, integrator, dt, sample_times);
-            }
-            const double seconds =
-              std::chrono::duration<double>(Clock::now() - start).count();
-            add_row(integrator, dt, seconds, samples);
-          }
-        }
+        const std::vector<StudyRow> of_model =
+          run_model(model, refinement, nu, reference, out);
+        rows.insert(rows.end(), of_model.begin(), of_model.end());
       }
+    return rows;
+  }
 
-    if (root)
+
+  std::vector<StudyRow>
+  Study::run_model(const std::string &model,
+                   const unsigned int refinement,
+                   const double       nu,
+                   const Reference   &reference,
+                   std::ostream      &out)
+  {
+    const bool         fem    = model.rfind("fem", 0) == 0;
+    const unsigned int degree = model == "fem p2" ? 2 : 1;
+    auto               scene  = make_study_scene(prm, refinement, model);
+    if (n_frequencies > 0)
     {
-      create_output_directory(output_directory);
-      const std::string  csv = output_directory + "/study.csv";
-      std::ostringstream file;
-      file
-        << "variant,model,tets,integrator,time_step,wall_time_s,error_rel_l2,error_max\n";
-      file << std::setprecision(8);
-      for (const auto &row : rows)
-        file << row.variant << ',' << row.model << ',' << row.tets << ','
-             << row.integrator << ',' << row.time_step << ','
-             << (test_mode ? 0.0 : row.wall_time) << ',' << row.error_l2 << ','
-             << row.error_max << '\n';
-      write_file_atomically(csv, file.str());
-      out << "Wrote " << (test_mode ? std::string("study.csv") : csv) << "\n";
-      if (plot)
+      const std::string label = model + " x" + std::to_string(refinement);
+      if (fem)
       {
-        const std::string command = std::string(LACERTA_PYTHON) + " '" + plot_script
-                                    + "' '" + csv + "' '" + output_directory
-                                    + "/study.png'";
-        if (std::system(command.c_str()) != 0)
-          throw_error("Study: the plot command failed: ",
-                      command,
-                      " (set 'Study/Plot' = false to skip the picture).");
-        out << "Wrote "
-            << (test_mode ? std::string("study.png") : output_directory + "/study.png")
-            << "\n";
+        SolverParameters parameters;
+        parameters.degree = degree;
+        print_frequencies(out,
+                          label,
+                          ElasticitySolver(problem_from_scene(*scene), parameters)
+                            .lowest_frequencies(n_frequencies));
+      }
+      else
+        print_frequencies(out, label, spring_frequencies(*scene->system, n_frequencies));
+    }
+    const auto                            &vertices = scene->mesh.get_vertices();
+    std::vector<std::vector<mesh::Point3>> expected;
+    for (const auto &field : reference.fields)
+      expected.push_back(evaluate(reference.scene->mesh, field, vertices));
+
+    std::vector<StudyRow> rows;
+    const auto            add_row =
+      [&](const std::string &integrator, const double dt, const TimedSamples &timed)
+    {
+      NodalError error;
+      for (std::size_t s = 0; s < timed.samples.size(); ++s)
+        error.add(nodal_error(timed.samples[s], expected[s]));
+      StudyRow row;
+      row.model         = model;
+      row.integrator    = integrator;
+      row.tets          = scene->mesh.n_tets();
+      row.time_step     = dt;
+      row.wall_time     = timed.seconds;
+      row.error_l2      = error.relative_l2();
+      row.error_max     = error.relative_max();
+      row.poisson_ratio = nu;
+      row.variant =
+        variant_name(model, refinement, integrator, dt, poisson_ratios.empty() ? -1 : nu);
+      rows.push_back(row);
+      print_row(out, row, test_mode);
+    };
+
+    if (fem)
+    {
+      for (const double dt : dynamic ? time_steps : std::vector<double>{0.0})
+        add_row(dynamic ? "newmark" : "cg-amg",
+                dt,
+                run_fem(*scene, degree, dt, sample_times));
+      return rows;
+    }
+    for (const std::string &integrator : integrators)
+    {
+      const bool explicit_scheme = integrator != "direct" && integrator != "relaxation";
+      if (dynamic && !explicit_scheme)
+        continue;
+      for (const double dt : explicit_scheme ? time_steps : std::vector<double>{0.0})
+      {
+        auto variant = make_study_scene(prm, refinement, model);
+        add_row(integrator,
+                dt,
+                run_particles(prm, *variant, integrator, dt, sample_times));
       }
     }
     return rows;
+  }
+
+
+  void
+  Study::write_results(const std::vector<StudyRow> &rows, std::ostream &out) const
+  {
+    create_output_directory(output_directory);
+    const std::string  csv = output_directory + "/study.csv";
+    std::ostringstream file;
+    file << "variant,model,tets,integrator,time_step,wall_time_s,error_rel_l2,error_max,"
+            "poisson_ratio\n";
+    file << std::setprecision(8);
+    for (const auto &row : rows)
+      file << row.variant << ',' << row.model << ',' << row.tets << ',' << row.integrator
+           << ',' << row.time_step << ',' << (test_mode ? 0.0 : row.wall_time) << ','
+           << row.error_l2 << ',' << row.error_max << ',' << row.poisson_ratio << '\n';
+    write_file_atomically(csv, file.str());
+    out << "Wrote " << (test_mode ? std::string("study.csv") : csv) << "\n";
+    if (!plot)
+      return;
+    const std::string command = std::string(LACERTA_PYTHON) + " '" + plot_script + "' '"
+                                + csv + "' '" + output_directory + "/study.png'";
+    if (std::system(command.c_str()) != 0)
+      throw_error("Study: the plot command failed: ",
+                  command,
+                  " (set 'Study/Plot' = false to skip the picture).");
+    out << "Wrote "
+        << (test_mode ? std::string("study.png") : output_directory + "/study.png")
+        << "\n";
   }
 } // namespace lacerta::fem

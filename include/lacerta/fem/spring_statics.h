@@ -45,7 +45,9 @@ namespace lacerta::fem
    * springs) plus, per tetrahedron of the model, the largest absolute row sum of its
    * element stiffness at i (which make a unit step stable by Gershgorin) and kinetic
    * damping (velocities reset whenever the kinetic energy falls), until the largest
-   * residual force is below @p tolerance times the largest load. The forces are the
+   * residual force is below @p tolerance times the largest load or, if larger, the
+   * largest residual force at the start (the pull of the prescribed particles, which
+   * drives a displacement-driven problem such as an indentation). The forces are the
    * system's own force model. Moves @p system's positions to the equilibrium; throws an
    * Error if @p max_iterations do not reach it.
    */

@@ -10,6 +10,7 @@
 
 #include <deal.II/base/parameter_handler.h>
 
+#include <iosfwd>
 #include <memory>
 #include <string>
 #include <vector>
@@ -49,6 +50,8 @@ namespace lacerta::fem
     double       wall_time = 0;
     double       error_l2  = 0;
     double       error_max = 0;
+    /// The Poisson ratio of the variant and of its reference.
+    double poisson_ratio = 0;
   };
 
 
@@ -60,6 +63,7 @@ namespace lacerta::fem
    * Dynamic analysis: springs by explicit integrators, FEM by Newmark, errors over the
    * nodes at `Number of samples` times, against FEM P2 Newmark on the reference mesh.
    * FEM runs on all MPI ranks; the serial spring variants run on every rank.
+   * With `Poisson ratios`, every variant and the reference run at each of them in turn.
    */
   class Study
   {
@@ -76,14 +80,37 @@ namespace lacerta::fem
     run();
 
   private:
+    /// Every variant at the Poisson ratio @p nu, against the reference at @p nu.
+    std::vector<StudyRow>
+    run_at_poisson_ratio(double nu, std::ostream &out);
+
+    /// The reference FEM P2 solution at the sample times, with its scene.
+    struct Reference;
+
+    /// The rows of one model at one refinement, against @p reference.
+    std::vector<StudyRow>
+    run_model(const std::string &model,
+              unsigned int       refinement,
+              double             nu,
+              const Reference   &reference,
+              std::ostream      &out);
+
+    /// Writes study.csv and, if asked, study.png (root rank only).
+    void
+    write_results(const std::vector<StudyRow> &rows, std::ostream &out) const;
+
     dealii::ParameterHandler &prm;
     bool                      dynamic;
     std::vector<unsigned int> refinements;
     std::vector<std::string>  models, integrators;
     std::vector<double>       time_steps;
-    unsigned int              reference_refinement;
-    double                    reference_time_step;
-    unsigned int              n_samples;
+    /// The Poisson ratios of the sweep; empty: the scene's `Material/Poisson ratio`.
+    std::vector<double> poisson_ratios;
+    /// The sample times: 'End time' (static) or 'Number of samples' up to it.
+    std::vector<double> sample_times;
+    unsigned int        reference_refinement;
+    double              reference_time_step;
+    unsigned int        n_samples;
     /// How many lowest frequencies to print per model and refinement (0: none).
     unsigned int n_frequencies = 0;
     bool         plot;
