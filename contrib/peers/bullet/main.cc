@@ -141,7 +141,7 @@ namespace
   }
 
 
-  /// One peer row of the study's table, with the Poisson ratio of the scene.
+  /// One peer row of the study's table (with its Poisson ratio) and Bullet's run.
   struct PeerRow
   {
     fem::StudyRow               row;
@@ -179,17 +179,19 @@ namespace
       peer.run.displacement,
       fem::evaluate(reference.scene->mesh, reference.field, scene->mesh.get_vertices()));
 
-    std::ostringstream dt;
+    std::ostringstream dt, nu;
     dt << settings.time_step;
+    nu << scene->material.poisson_ratio;
     peer.row.model      = "bullet corotated";
     peer.row.integrator = "bullet implicit";
     peer.row.variant    = "bullet_corotated_x" + std::to_string(refinement)
-                       + "_bullet_implicit_dt=" + dt.str();
-    peer.row.tets      = scene->mesh.n_tets();
-    peer.row.time_step = settings.time_step;
-    peer.row.wall_time = peer.run.wall_time;
-    peer.row.error_l2  = error.relative_l2();
-    peer.row.error_max = error.relative_max();
+                       + "_bullet_implicit_dt=" + dt.str() + "_nu=" + nu.str();
+    peer.row.tets          = scene->mesh.n_tets();
+    peer.row.time_step     = settings.time_step;
+    peer.row.wall_time     = peer.run.wall_time;
+    peer.row.error_l2      = error.relative_l2();
+    peer.row.error_max     = error.relative_max();
+    peer.row.poisson_ratio = scene->material.poisson_ratio;
     return peer;
   }
 
@@ -208,9 +210,7 @@ namespace
 
 
   void
-  write_csv(const std::string          &file_name,
-            const std::vector<PeerRow> &rows,
-            const double                poisson_ratio)
+  write_csv(const std::string &file_name, const std::vector<PeerRow> &rows)
   {
     std::ostringstream file;
     file << "variant,model,tets,integrator,time_step,wall_time_s,error_rel_l2,error_max,"
@@ -221,7 +221,7 @@ namespace
       const fem::StudyRow &r = peer.row;
       file << r.variant << ',' << r.model << ',' << r.tets << ',' << r.integrator << ','
            << r.time_step << ',' << r.wall_time << ',' << r.error_l2 << ',' << r.error_max
-           << ',' << poisson_ratio << '\n';
+           << ',' << r.poisson_ratio << '\n';
     }
     write_file_atomically(file_name, file.str());
   }
@@ -249,28 +249,39 @@ namespace
                   options.parameter_file,
                   "' asks for a dynamic study; the Bullet peer computes the static "
                   "equilibrium only (Study/Analysis = static).");
+    // The study's Poisson ratio sweep (empty: the scene's ratio), each ν with its own
+    // reference, as the study runs it.
+    prm.enter_subsection("Study");
+    std::vector<double> ratios = dealii::Utilities::string_to_double(
+      dealii::Utilities::split_string_list(prm.get("Poisson ratios")));
+    prm.leave_subsection();
     prm.enter_subsection("Material");
-    const double poisson_ratio = prm.get_double("Poisson ratio");
+    if (ratios.empty())
+      ratios.push_back(prm.get_double("Poisson ratio"));
     prm.leave_subsection();
 
-    const Reference      reference = compute_reference(prm, reference_refinement);
     std::vector<PeerRow> rows;
-    for (const int refinement : refinements)
+    for (const double nu : ratios)
     {
-      for (const double dt : options.time_steps)
-      {
-        peers::bullet::BulletSettings settings = options.settings;
-        settings.time_step                     = dt;
-        rows.push_back(run_refinement(prm, refinement, reference, settings));
-        print_row(rows.back());
-      }
+      prm.enter_subsection("Material");
+      prm.set("Poisson ratio", nu);
+      prm.leave_subsection();
+      const Reference reference = compute_reference(prm, reference_refinement);
+      for (const int refinement : refinements)
+        for (const double dt : options.time_steps)
+        {
+          peers::bullet::BulletSettings settings = options.settings;
+          settings.time_step                     = dt;
+          rows.push_back(run_refinement(prm, refinement, reference, settings));
+          print_row(rows.back());
+        }
     }
 
     const std::string csv =
       options.output.empty() ? output_directory + "/peer_bullet.csv" : options.output;
     if (options.output.empty())
       create_output_directory(output_directory);
-    write_csv(csv, rows, poisson_ratio);
+    write_csv(csv, rows);
     std::cout << "Wrote " << csv << "\n";
     return 0;
   }
