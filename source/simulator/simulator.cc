@@ -28,6 +28,7 @@
 #include <iostream>
 #include <numeric>
 #include <sstream>
+#include <thread>
 #include <unistd.h>
 
 namespace lacerta
@@ -136,10 +137,14 @@ namespace lacerta
       dealii::Patterns::Double(1e-12, 10.0),
       "Time step [s]. If it is above the stability limit the run sub-steps "
       "or stops (see 'Stability/Time step above limit').");
-    prm.declare_entry("Number of threads",
-                      "1",
-                      dealii::Patterns::Integer(1, 256),
-                      "Threads for the force evaluation.");
+    prm.declare_entry(
+      "Number of threads",
+      "0",
+      dealii::Patterns::Integer(0, 256),
+      "Threads for the force evaluation (every force model: each thread evaluates the "
+      "forces on its own range of particles); 0: one per core of the machine. Runs "
+      "with different counts differ by rounding only (the order of a particle's "
+      "force sum).");
     prm.declare_entry(
       "Test mode",
       "false",
@@ -274,6 +279,8 @@ namespace lacerta
     end_time         = prm.get_double("End time");
     time_step        = prm.get_double("Time step");
     n_threads        = prm.get_integer("Number of threads");
+    if (n_threads == 0)
+      n_threads = std::max(1u, std::thread::hardware_concurrency());
     test_mode        = prm.get_bool("Test mode");
     check_invariants = prm.get_bool("Check invariants");
     prm.enter_subsection("Stability");
