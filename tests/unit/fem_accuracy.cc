@@ -5,6 +5,7 @@
 #include <lacerta/fem/nodal_field.h>
 #include <lacerta/fem/scene_problem.h>
 #include <lacerta/fem/spring_statics.h>
+#include <lacerta/fem/study.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/scene/scene.h>
 #include <lacerta/simulator/simulator.h>
@@ -14,7 +15,6 @@
 #include <gtest/gtest.h>
 
 #include "pulled_bar.h"
-#include <array>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -335,23 +335,14 @@ namespace
 {
   using namespace lacerta;
 
-  /// The scene @p file with its box of @p base repetitions multiplied by @p factor, as
-  /// the study refines it.
+  /// The study scene @p file with its box multiplied by @p factor: the study's own
+  /// refinement (fem::make_study_scene()), with the paper's springs.
   std::unique_ptr<scene::Scene>
-  refined_scene(const std::string                 &file,
-                const std::array<unsigned int, 3> &base,
-                const unsigned int                 factor)
+  refined_scene(const std::string &file, const unsigned int factor)
   {
-    return load_scene(file,
-                      [&](dealii::ParameterHandler &prm)
-                      {
-                        set_entry(prm,
-                                  {"Mesh", "Box"},
-                                  "Repetitions",
-                                  std::to_string(base[0] * factor) + ", "
-                                    + std::to_string(base[1] * factor) + ", "
-                                    + std::to_string(base[2] * factor));
-                      });
+    dealii::ParameterHandler prm;
+    Simulator::read_parameters(scenes + file, prm);
+    return fem::make_study_scene(prm, factor, "springs");
   }
 
 
@@ -359,7 +350,7 @@ namespace
   std::unique_ptr<scene::Scene>
   square_study_scene(const unsigned int factor)
   {
-    return refined_scene("square_pull_accuracy.prm", {4, 4, 1}, factor);
+    return refined_scene("square_pull_accuracy.prm", factor);
   }
 
 
@@ -426,7 +417,7 @@ namespace
   std::unique_ptr<scene::Scene>
   indentation_study_scene(const unsigned int factor)
   {
-    return refined_scene("indentation_accuracy.prm", {4, 4, 2}, factor);
+    return refined_scene("indentation_accuracy.prm", factor);
   }
 
 
