@@ -92,6 +92,38 @@ namespace lacerta::fem
   }
 
 
+  namespace
+  {
+    /**
+     * The id of the edge (@p a, @p b) of tetrahedron @p t of @p mesh, from the
+     * tetrahedron's own edge ids: after a cut the mesh's edge list is no longer sorted,
+     * so it cannot be searched.
+     */
+    unsigned int
+    edge_of_tet(const mesh::TetMesh &mesh,
+                const unsigned int   t,
+                const unsigned int   a,
+                const unsigned int   b)
+    {
+      const auto &vertices = mesh.tet(t);
+      for (unsigned int k = 0; k < 6; ++k)
+      {
+        const unsigned int p = vertices[mesh::TetMesh::edge_vertices[k][0]];
+        const unsigned int q = vertices[mesh::TetMesh::edge_vertices[k][1]];
+        if ((p == a && q == b) || (p == b && q == a))
+          return mesh.tet_edges(t)[k];
+      }
+      throw_error("FEM reference: vertices ",
+                  a,
+                  " and ",
+                  b,
+                  " are no edge of tetrahedron ",
+                  t,
+                  ".");
+    }
+  } // namespace
+
+
   /**
    * Where a degree of freedom sits on the Problem's mesh: the vertex a (b == a) or the
    * midpoint of the edge (a, b), and its component.
@@ -100,6 +132,8 @@ namespace lacerta::fem
   {
     types::global_dof_index dof;
     unsigned int            a, b, component;
+    /// The mesh's id of edge (a, b) for an edge node (mesh.get_edges() order).
+    unsigned int edge;
   };
 
 
@@ -273,7 +307,12 @@ namespace lacerta::fem
         if (problem.prescribed[a] && problem.prescribed[b])
           constraints.add_line(dofs[i]);
         if (owned.is_element(dofs[i]))
-          owned_nodes.push_back({dofs[i], std::min(a, b), std::max(a, b), component});
+          owned_nodes.push_back(
+            {dofs[i],
+             std::min(a, b),
+             std::max(a, b),
+             component,
+             a == b ? mesh::invalid_index : edge_of_tet(mesh, t, a, b)});
       }
     }
     constraints.close();
@@ -495,20 +534,13 @@ namespace lacerta::fem
     field.vertex.assign(3 * mesh.n_vertices(), 0.0);
     if (field.degree == 2)
       field.edge.assign(3 * mesh.n_edges(), 0.0);
-    const auto &edges = mesh.get_edges();
     for (const auto &node : owned_nodes)
     {
       const double value = values(node.dof);
       if (node.a == node.b)
         field.vertex[3 * node.a + node.component] = value;
       else
-      {
-        const auto e = std::lower_bound(edges.begin(),
-                                        edges.end(),
-                                        std::array<unsigned int, 2>{node.a, node.b})
-                       - edges.begin();
-        field.edge[3 * e + node.component] = value;
-      }
+        field.edge[3 * node.edge + node.component] = value;
     }
     // Every dof is owned by exactly one rank: a sum gathers the field everywhere.
     Utilities::MPI::sum(field.vertex, communicator, field.vertex);

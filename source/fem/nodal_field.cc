@@ -22,19 +22,6 @@ namespace lacerta::fem
       const double l2     = mesh::signed_volume(a, b, p, d) / volume;
       return {l0, l1, l2, 1.0 - l0 - l1 - l2};
     }
-
-
-    /// Index of edge (a, b) in the sorted edge list.
-    unsigned int
-    edge_index(const mesh::TetMesh &mesh, unsigned int a, unsigned int b)
-    {
-      if (a > b)
-        std::swap(a, b);
-      const auto &edges = mesh.get_edges();
-      const auto  found =
-        std::lower_bound(edges.begin(), edges.end(), std::array<unsigned int, 2>{a, b});
-      return static_cast<unsigned int>(found - edges.begin());
-    }
   } // namespace
 
 
@@ -137,9 +124,11 @@ namespace lacerta::fem
         for (unsigned int i = 0; i < 4; ++i)
           for (unsigned int d = 0; d < 3; ++d)
             u[d] += lambda[i] * (2 * lambda[i] - 1) * field.vertex[3 * v[i] + d];
-        for (const auto &[i, j] : mesh::TetMesh::edge_vertices)
+        // The tetrahedron's own edge ids: after a cut the edge list is not sorted.
+        for (unsigned int k = 0; k < 6; ++k)
         {
-          const unsigned int e = edge_index(mesh, v[i], v[j]);
+          const auto &[i, j]   = mesh::TetMesh::edge_vertices[k];
+          const unsigned int e = mesh.tet_edges(tet)[k];
           for (unsigned int d = 0; d < 3; ++d)
             u[d] += 4 * lambda[i] * lambda[j] * field.edge[3 * e + d];
         }

@@ -1,7 +1,5 @@
 // The fields of the `fem comparison` postprocessor (Time between fields): the files
 // hold the mesh at rest and both displacements, consistent with the error it prints.
-#include <lacerta/simulator/simulator.h>
-
 #include <gtest/gtest.h>
 #include <vtkDataArray.h>
 #include <vtkPointData.h>
@@ -9,6 +7,7 @@
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLUnstructuredGridReader.h>
 
+#include "simulator_test_support.h"
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -46,25 +45,14 @@ namespace lacerta
     const std::filesystem::path directory =
       std::filesystem::temp_directory_path() / "lacerta_fem_comparison_fields";
     std::filesystem::remove_all(directory);
-    const std::string file = (directory.string() + ".prm");
-    {
-      std::ofstream out(file);
-      out << "include " LACERTA_SCENE_DIR "/square_pull_comparison.prm\n"
+    std::ostringstream scene;
+    scene << "include " LACERTA_SCENE_DIR "/square_pull_comparison.prm\n"
           << "set End time = 0.02\nset Test mode = true\n"
           << "set Output directory = " << directory.string() << "\n"
           << "subsection Postprocess\n  subsection Fem comparison\n"
           << "    set Time between fields = 0.01\n    set Number of frequencies = 0\n"
           << "  end\nend\n";
-    }
-    dealii::ParameterHandler prm;
-    Simulator::read_parameters(file, prm);
-    std::filesystem::remove(file);
-    {
-      std::ostringstream quiet;
-      auto *const        old = std::cout.rdbuf(quiet.rdbuf());
-      Simulator(prm, file).run();
-      std::cout.rdbuf(old);
-    }
+    test::run_scene_quietly(directory.string() + ".prm", scene.str());
 
     // Written at the first step and then every 0.01 s: 0.0005, 0.01, 0.02.
     for (const char *name :

@@ -134,7 +134,12 @@ namespace lacerta::mesh
       return neighbors[4 * t + f];
     }
 
-    /// The unique edges as pairs of vertex ids (first < second), sorted.
+    /**
+     * The unique edges as pairs of vertex ids (first < second): sorted when the mesh is
+     * built, but no longer after replace_tets() (a cut appends new edges and moves the
+     * last into a retired one's id), so look an edge of a tetrahedron up by tet_edges(),
+     * not by searching this list.
+     */
     const std::vector<std::array<unsigned int, 2>> &
     get_edges() const
     {
