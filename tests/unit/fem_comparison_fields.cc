@@ -10,36 +10,12 @@
 #include "simulator_test_support.h"
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 namespace lacerta
 {
-  namespace
-  {
-    /// The relative L2 error column of the row of @p csv at time @p time.
-    double
-    error_at(const std::string &csv, const double time)
-    {
-      std::ifstream in(csv);
-      std::string   line;
-      std::getline(in, line);
-      while (std::getline(in, line))
-      {
-        std::istringstream row(line);
-        double             t = 0, error = 0;
-        char               comma;
-        row >> t >> comma >> error;
-        if (std::abs(t - time) < 1e-9)
-          return error;
-      }
-      return -1;
-    }
-  } // namespace
-
-
   TEST(FemComparisonFields, FilesHoldBothDisplacementsAndTheirDifference)
   {
     const std::filesystem::path directory =
@@ -81,7 +57,10 @@ namespace lacerta
       }
     EXPECT_GT(squared_reference, 0);
     // The same error as the table's row of that step.
-    const double table = error_at((directory / "comparison.csv").string(), 0.02);
+    double table = -1;
+    for (const test::ComparisonRow &row : test::read_comparison_rows(directory))
+      if (std::abs(row.time - 0.02) < 1e-9)
+        table = row.error_rel_l2;
     ASSERT_GT(table, 0);
     EXPECT_NEAR(std::sqrt(squared_error / squared_reference), table, 1e-5 * table);
     std::filesystem::remove_all(directory);

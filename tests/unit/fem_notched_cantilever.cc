@@ -15,9 +15,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -25,20 +23,13 @@ namespace lacerta
 {
   namespace
   {
-    /// A row of comparison.csv with one probe: time, errors, and both displacements.
-    struct Row
-    {
-      double              time = 0, error_rel_l2 = 0, error_max = 0;
-      std::vector<double> probe;
-    };
-
     /// What a run gives: the rows of comparison.csv, and the largest difference of the
     /// FEM displacements of two vertices at the same rest position (the two sides of
     /// the crack) over that of any vertex, in the fields of the last comparison.
     struct Result
     {
-      std::vector<Row> rows;
-      double           crack_opening = 0, largest_displacement = 0;
+      std::vector<test::ComparisonRow> rows;
+      double                           crack_opening = 0, largest_displacement = 0;
     };
 
     /// The crack opening and largest displacement of fem_displacement in @p file.
@@ -70,28 +61,6 @@ namespace lacerta
       }
     }
 
-    /// The rows of comparison.csv in @p directory.
-    std::vector<Row>
-    read_rows(const std::filesystem::path &directory)
-    {
-      std::ifstream    in(directory / "comparison.csv");
-      std::string      line;
-      std::vector<Row> rows;
-      std::getline(in, line);
-      while (std::getline(in, line))
-      {
-        std::istringstream row(line);
-        Row                r;
-        char               comma;
-        row >> r.time >> comma >> r.error_rel_l2 >> comma >> r.error_max;
-        double value = 0;
-        while (row >> comma >> value)
-          r.probe.push_back(value);
-        rows.push_back(r);
-      }
-      return rows;
-    }
-
     /**
      * Runs the notched cantilever on 10 x 2 x 2 boxes with @p model (the lines that
      * choose it): settled at 0.5 s, notched until 0.6 s, compared at 0.5 s (uncut) and
@@ -115,7 +84,7 @@ namespace lacerta
             " subsection Fem comparison\n  set Time between fields = 0.6\n end\nend\n"
           + model);
       Result result;
-      result.rows = read_rows(directory);
+      result.rows = test::read_comparison_rows(directory);
       // Fields at the two comparisons: 00000 before the cut, 00001 after it.
       read_crack_opening(directory / "comparison-00001.vtu", result);
       std::filesystem::remove_all(directory);
@@ -130,7 +99,7 @@ namespace lacerta
     check_notched(const Result &result, const double bound)
     {
       EXPECT_GT(result.crack_opening, 0.02 * result.largest_displacement);
-      const std::vector<Row> &rows = result.rows;
+      const std::vector<test::ComparisonRow> &rows = result.rows;
       ASSERT_EQ(rows.size(), 2u);
       EXPECT_NEAR(rows[0].time, 0.5, 1e-9);
       EXPECT_NEAR(rows[1].time, 1.2, 1e-9);
@@ -141,7 +110,7 @@ namespace lacerta
       EXPECT_LT(fem_before, 0);
       // The notch takes 9 of the 20 mm of depth near the clamp: the tip sags more.
       EXPECT_LT(fem_after, 1.05 * fem_before);
-      for (const Row &r : rows)
+      for (const test::ComparisonRow &r : rows)
       {
         EXPECT_TRUE(std::isfinite(r.error_rel_l2));
         EXPECT_GT(r.error_rel_l2, 0);

@@ -10,6 +10,7 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace lacerta::test
 {
@@ -39,5 +40,35 @@ namespace lacerta::test
       throw;
     }
     std::cout.rdbuf(old);
+  }
+
+  /// A row of the `fem comparison` postprocessor's comparison.csv: time, relative L2
+  /// and largest error, then the probes' columns in their order.
+  struct ComparisonRow
+  {
+    double              time = 0, error_rel_l2 = 0, error_max = 0;
+    std::vector<double> probe;
+  };
+
+  /// The rows of comparison.csv in @p directory (none when the file is missing).
+  inline std::vector<ComparisonRow>
+  read_comparison_rows(const std::filesystem::path &directory)
+  {
+    std::ifstream              in(directory / "comparison.csv");
+    std::string                line;
+    std::vector<ComparisonRow> rows;
+    std::getline(in, line);
+    while (std::getline(in, line))
+    {
+      std::istringstream row(line);
+      ComparisonRow      r;
+      char               comma;
+      row >> r.time >> comma >> r.error_rel_l2 >> comma >> r.error_max;
+      double value = 0;
+      while (row >> comma >> value)
+        r.probe.push_back(value);
+      rows.push_back(r);
+    }
+    return rows;
   }
 } // namespace lacerta::test
