@@ -25,7 +25,7 @@ case "$mode" in
     # Allow mpirun as root (CI runs as root) for the MPI tests.
     export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
     ctest --test-dir "$build" --parallel "$(nproc)" --output-on-failure --timeout 900
-    # The same suite again, built by clang with AddressSanitizer and
+    # The same suite again (but for the long scenes), built by clang with AddressSanitizer and
     # UndefinedBehaviorSanitizer (LACERTA_SANITIZE) and libFuzzer's coverage
     # (LACERTA_FUZZ), with the fuzz.* tests: the first report stops the test that made
     # it. Leak checking is off (MPI and TBB keep their pools to the exit), and so is the
@@ -39,7 +39,10 @@ case "$mode" in
     cmake --build "$asan" --parallel "$(nproc)" --target lacerta lacerta-view lacerta-unit-tests \
       lacerta-bench lacerta-fuzz-gmsh_reader lacerta-fuzz-vtk_readers \
       lacerta-fuzz-parameter_file lacerta-fuzz-cutter
-    ctest --test-dir "$asan" --parallel "$(nproc)" --output-on-failure --timeout 900
+    # Without the scenes labelled `long` (tests/CMakeLists.txt): the Release suite has
+    # run them.
+    ctest --test-dir "$asan" --parallel "$(nproc)" --output-on-failure --timeout 900 \
+      --label-exclude long
     ;;
   *)
     echo "usage: $0 run|test" >&2
