@@ -142,3 +142,93 @@ TEST(CutBoundaryFaceTree, AnswersLikeASearchOfEveryFaceAsTheTissueDeforms)
   // Unchanged positions need no refit.
   EXPECT_FALSE(tree.refit(mesh, x.data()));
 }
+
+
+namespace
+{
+  /**
+   * Splits the boundary face (tet, face) of @p mesh at its centroid, as a cut replaces
+   * boundary faces by smaller ones: the cell becomes three cells, the face three
+   * boundary faces, which are given to @p tree; @p x gets the new vertex at the
+   * centroid of the face at @p x.
+   */
+  void
+  split_boundary_face(mesh::TetMesh       &mesh,
+                      std::vector<double> &x,
+                      BoundaryFaceTree    &tree,
+                      const unsigned int   tet,
+                      const unsigned int   face)
+  {
+    const mesh::Tet                    old   = mesh.tet(tet);
+    const std::array<unsigned int, 3> &local = mesh::TetMesh::face_vertices[face];
+    mesh::Point3                       centre;
+    std::array<double, 3>              deformed{};
+    for (const unsigned int k : local)
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        centre[d] += mesh.vertex(old[k])[d] / 3;
+        deformed[d] += x[3 * old[k] + d] / 3;
+      }
+    const unsigned int p = mesh.add_vertex(centre);
+    x.insert(x.end(), deformed.begin(), deformed.end());
+    std::vector<mesh::Tet> children;
+    for (const unsigned int k : local)
+    {
+      mesh::Tet child = old;
+      child[k]        = p;
+      children.push_back(child);
+    }
+    std::vector<std::array<unsigned int, 4>> ids(children.size(), {{0, 0, 0, 0}});
+    std::vector<unsigned int>                added;
+    mesh::TetMesh::EdgeUpdate                update;
+    mesh.replace_tets({tet}, children, ids, added, update);
+    for (const unsigned int c : added)
+      for (unsigned int f = 0; f < 4; ++f)
+        if (mesh.neighbor(c, f) == mesh::invalid_index)
+          tree.add_face(mesh, c, f);
+  }
+} // namespace
+
+
+TEST(CutBoundaryFaceTree, FacesAddedByCutsAreFoundAndMergedLogarithmically)
+{
+  std::mt19937  rng(5);
+  mesh::TetMesh mesh = box_tet_mesh(4, rng);
+  mesh.enable_local_updates();
+  std::vector<double> x(3 * mesh.n_vertices());
+  for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
+    for (unsigned int d = 0; d < 3; ++d)
+      x[3 * v + d] = mesh.vertex(v)[d] * (1 + 0.1 * d);
+  BoundaryFaceTree tree;
+  tree.build(mesh, x.data());
+  const std::size_t initial = tree.size();
+  ASSERT_EQ(initial, mesh.get_boundary_faces().size());
+
+  // Boundary faces split one at a time, the tissue drifting meanwhile; every few
+  // splits the tree is refitted (as the cutter does before each blade motion) and its
+  // answers checked against a search of every face. The pending list becomes trees of
+  // the logarithmic method; past the mesh's own boundary in added faces the whole tree
+  // is rebuilt (its size then counts the live faces only).
+  unsigned int most_trees = 0, rebuilds = 0;
+  std::size_t  last_size = tree.size();
+  for (unsigned int split = 1; split <= 400; ++split)
+  {
+    const auto &faces = mesh.get_boundary_faces();
+    const auto  bf =
+      faces[std::uniform_int_distribution<std::size_t>(0, faces.size() - 1)(rng)];
+    split_boundary_face(mesh, x, tree, bf.tet, bf.face);
+    if (split % 10 != 0)
+      continue;
+    for (double &c : x)
+      c += 0.004;
+    tree.refit(mesh, x.data());
+    most_trees = std::max(most_trees, tree.n_added_trees());
+    rebuilds += tree.size() < last_size;
+    last_size = tree.size();
+    expect_same_answers(tree, mesh, x, rng, "after split " + std::to_string(split));
+    ASSERT_FALSE(::testing::Test::HasFailure());
+  }
+  EXPECT_EQ(mesh.get_boundary_faces().size(), initial + 2 * 400);
+  EXPECT_GE(most_trees, 2u);
+  EXPECT_GE(rebuilds, 1u);
+}
