@@ -241,8 +241,10 @@ TEST(ElementModels, BoundIsAboveTheTrueFrequencyAndStableAtNinetyPercent)
         {
           integrator->step(*run, step * dt, dt);
           if (step % 100 == 0)
+          {
             EXPECT_NO_THROW(monitor.check(*run, step, step * dt))
               << model << ", " << name;
+          }
         }
         EXPECT_LT(run->kinetic_energy() + run->elastic_energy(), 1.5 * initial)
           << model << ", " << name << ", nu " << nu;

@@ -155,3 +155,51 @@ TEST(ForceModelLocalUpdate, RemovingEverySpringLeavesNoForce)
   EXPECT_EQ(*std::max_element(f.begin(), f.end()), 0.0) << n << " springs removed";
   EXPECT_EQ(*std::min_element(f.begin(), f.end()), 0.0) << n << " springs removed";
 }
+
+
+TEST(LinearSprings, LargeRangesGiveTheSpringLawToTheLastBit)
+{
+  // 34³ = 39,304 particles: on one thread the range is large enough for the loop to
+  // fetch ahead (doc/physics.md, "The hot loop"), which must not change a bit of the
+  // forces: a plain loop over the springs in their order, with and without damping.
+  const mesh::TetMesh mesh   = test_support::distorted_box(33, 0.2, {1, 1, 1});
+  auto                system = test_support::make_system(mesh, 1000, 1e4, 1);
+  ASSERT_GT(system->n_particles(), 32768u);
+  std::mt19937                           rng(7);
+  std::uniform_real_distribution<double> jitter(-0.005, 0.005);
+  std::vector<double>                    x(system->position), v(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i)
+  {
+    x[i] += jitter(rng);
+    v[i] = 10 * jitter(rng);
+  }
+  for (const double beta : {0.0, 1e-3})
+  {
+    system->spring_damping = beta;
+    std::vector<double> mine(x.size()), expected(x.size(), 0.0);
+    system->force_model().compute_spring_forces(*system, x.data(), v.data(), mine.data());
+    const physics::SpringSet &springs = system->springs;
+    for (std::size_t s = 0; s < springs.size(); ++s)
+    {
+      const std::size_t i = 3 * std::size_t(springs.a[s]),
+                        j = 3 * std::size_t(springs.b[s]);
+      const double dx = x[j] - x[i], dy = x[j + 1] - x[i + 1], dz = x[j + 2] - x[i + 2];
+      const double len       = std::sqrt(dx * dx + dy * dy + dz * dz);
+      const double inv       = 1.0 / len;
+      const double k         = springs.stiffness[s];
+      double       magnitude = k * (len - springs.rest_length[s]);
+      if (beta > 0)
+        magnitude += beta * k * inv
+                     * ((v[j] - v[i]) * dx + (v[j + 1] - v[i + 1]) * dy
+                        + (v[j + 2] - v[i + 2]) * dz);
+      const double scale = magnitude * inv;
+      expected[i] += scale * dx;
+      expected[i + 1] += scale * dy;
+      expected[i + 2] += scale * dz;
+      expected[j] -= scale * dx;
+      expected[j + 1] -= scale * dy;
+      expected[j + 2] -= scale * dz;
+    }
+    EXPECT_EQ(mine, expected) << "damping " << beta;
+  }
+}

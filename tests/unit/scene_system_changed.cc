@@ -67,7 +67,9 @@ namespace lacerta
         EXPECT_EQ(c.tear != nullptr, c.cause == Cause::laceration);
         EXPECT_EQ(c.mt_cut != nullptr, c.cause == Cause::multiresolution_cut);
         if (c.mt_cut)
+        {
           EXPECT_EQ(c.mt_cut->n_tets, scene->active_mesh().n_tets());
+        }
       });
     const unsigned int n_steps = 60;
     unsigned int       changes = 0;
@@ -102,7 +104,9 @@ namespace lacerta
     const bool         changed = scene->update_level_of_detail(1.0, 2000000, log);
     ASSERT_EQ(heard.size(), before + 1 + (changed ? 1 : 0));
     if (changed)
+    {
       EXPECT_EQ(heard.back().cause, Cause::level_of_detail);
+    }
   }
 
 
