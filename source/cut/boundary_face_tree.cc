@@ -303,11 +303,12 @@ namespace lacerta::cut
   }
 
 
+  template <class Meets>
   void
   BoundaryFaceTree::query_tree(const Tree          &tree,
                                const mesh::TetMesh &mesh,
                                const double        *x,
-                               const Box           &box,
+                               const Meets         &meets,
                                std::vector<Face>   &hits)
   {
     if (tree.nodes.empty())
@@ -318,13 +319,12 @@ namespace lacerta::cut
     while (top > 0)
     {
       const Node &n = tree.nodes[stack[--top]];
-      if (!n.box.overlaps(box))
+      if (!meets(n.box))
         continue;
       if (n.count > 0)
       {
         for (unsigned int k = n.first; k < n.first + n.count; ++k)
-          if (face_box(tree.faces[k], x).overlaps(box)
-              && still_boundary(mesh, tree.faces[k]))
+          if (meets(face_box(tree.faces[k], x)) && still_boundary(mesh, tree.faces[k]))
             hits.push_back(tree.faces[k]);
       }
       else
@@ -336,18 +336,19 @@ namespace lacerta::cut
   }
 
 
+  template <class Meets>
   void
-  BoundaryFaceTree::query(const mesh::TetMesh &mesh,
-                          const double        *x,
-                          const Box           &box,
-                          std::vector<Face>   &hits) const
+  BoundaryFaceTree::collect(const mesh::TetMesh &mesh,
+                            const double        *x,
+                            const Meets         &meets,
+                            std::vector<Face>   &hits) const
   {
     const std::size_t begin = hits.size();
-    query_tree(boundary, mesh, x, box, hits);
+    query_tree(boundary, mesh, x, meets, hits);
     for (const Tree &tree : added)
-      query_tree(tree, mesh, x, box, hits);
+      query_tree(tree, mesh, x, meets, hits);
     for (const Face &f : extra)
-      if (face_box(f, x).overlaps(box) && still_boundary(mesh, f))
+      if (meets(face_box(f, x)) && still_boundary(mesh, f))
         hits.push_back(f);
     // In a canonical order, once each: what the trees hold, and how, does not change
     // the cutter's seeds. (A cut hands over every boundary face of the cells it makes,
@@ -362,5 +363,33 @@ namespace lacerta::cut
                            [&](const Face &a, const Face &b)
                            { return key(a) == key(b); }),
                hits.end());
+  }
+
+
+  void
+  BoundaryFaceTree::query(const mesh::TetMesh &mesh,
+                          const double        *x,
+                          const Box           &box,
+                          std::vector<Face>   &hits) const
+  {
+    collect(
+      mesh, x, [&](const Box &b) { return b.overlaps(box); }, hits);
+  }
+
+
+  void
+  BoundaryFaceTree::query(const mesh::TetMesh                       &mesh,
+                          const double                              *x,
+                          const std::array<std::array<Point, 3>, 2> &triangles,
+                          std::vector<Face>                         &hits) const
+  {
+    Box all = Box::around(triangles[0]);
+    all.extend(Box::around(triangles[1]));
+    collect(
+      mesh,
+      x,
+      [&](const Box &b)
+      { return b.overlaps(all) && (b.meets(triangles[0]) || b.meets(triangles[1])); },
+      hits);
   }
 } // namespace lacerta::cut

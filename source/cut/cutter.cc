@@ -126,6 +126,9 @@ namespace lacerta::cut
       , front(initial)
       , last_end(initial)
   {
+    // The split table is built on first use (about 10 ms): now, so that the first cut
+    // of a run does not wait for it.
+    split_table_entries();
     mesh.enable_local_updates();
     // Room for half as much again, so that the cuts of a stroke copy no mesh-sized
     // array (past it, the arrays double as usual: one copy, amortised).
@@ -259,12 +262,8 @@ namespace lacerta::cut
     for (const unsigned int t : active)
       push(t);
     // First contact: the swept triangles against the boundary faces, through the tree.
-    Box box;
-    for (const auto &tri : swept)
-      for (const Point &p : tri)
-        box.extend(p);
     hits.clear();
-    tree.query(mesh, system.position.data(), box, hits);
+    tree.query(mesh, system.position.data(), swept, hits);
     for (const auto &f : hits)
     {
       const auto tri = BoundaryFaceTree::triangle(f, system.position.data());

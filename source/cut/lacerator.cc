@@ -105,6 +105,9 @@ namespace lacerta::cut
     // The element size of the tissue as built: the mean surface spring at rest.
     for (const SurfaceSpring &spring : surface)
       typical_edge += spring.rest_length / surface.size();
+    // The split table is built on first use (about 10 ms): now, so that the first tear
+    // does not wait for it.
+    split_table_entries();
   }
 
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <set>
 #include <tuple>
 #include <vector>
 
@@ -231,4 +232,147 @@ TEST(CutBoundaryFaceTree, FacesAddedByCutsAreFoundAndMergedLogarithmically)
   EXPECT_EQ(mesh.get_boundary_faces().size(), initial + 2 * 400);
   EXPECT_GE(most_trees, 2u);
   EXPECT_GE(rebuilds, 1u);
+}
+
+
+namespace
+{
+  /// A random point in [lo, hi]³.
+  cut::Point
+  random_point(std::mt19937 &rng, const double lo, const double hi)
+  {
+    std::uniform_real_distribution<double> u(lo, hi);
+    return {{u(rng), u(rng), u(rng)}};
+  }
+
+  /// Whether triangle @p t meets box @p b, by its pieces: a vertex inside, a box edge
+  /// through the triangle, or a triangle edge through a face of the box.
+  bool
+  triangle_meets_box(const std::array<cut::Point, 3> &t, const Box &b)
+  {
+    const auto inside = [&](const cut::Point &p)
+    {
+      for (unsigned int d = 0; d < 3; ++d)
+        if (p[d] < b.lower[d] || p[d] > b.upper[d])
+          return false;
+      return true;
+    };
+    for (const cut::Point &p : t)
+      if (inside(p))
+        return true;
+    std::array<cut::Point, 8> corner;
+    for (unsigned int c = 0; c < 8; ++c)
+      for (unsigned int d = 0; d < 3; ++d)
+        corner[c][d] = (c >> d) & 1 ? b.upper[d] : b.lower[d];
+    double s = 0;
+    for (unsigned int c = 0; c < 8; ++c)
+      for (unsigned int d = 0; d < 3; ++d)
+        if (!((c >> d) & 1)
+            && cut::segment_hits_triangle(
+              corner[c], corner[c | (1u << d)], t[0], t[1], t[2], s))
+          return true;
+    // The box's faces as two triangles each: corners with bit d fixed.
+    for (unsigned int d = 0; d < 3; ++d)
+      for (unsigned int side = 0; side < 2; ++side)
+      {
+        const unsigned int e = (d + 1) % 3, f = (d + 2) % 3, base = side << d;
+        const cut::Point  &p00 = corner[base], &p10 = corner[base | (1u << e)],
+                         &p01 = corner[base | (1u << f)],
+                         &p11 = corner[base | (1u << e) | (1u << f)];
+        for (unsigned int k = 0; k < 3; ++k)
+          if (cut::segment_hits_triangle(t[k], t[(k + 1) % 3], p00, p10, p11, s)
+              || cut::segment_hits_triangle(t[k], t[(k + 1) % 3], p00, p11, p01, s))
+            return true;
+      }
+    return false;
+  }
+} // namespace
+
+
+TEST(CutBoundaryFaceTree, BoxMeetsEveryTriangleThatTouchesIt)
+{
+  // Boxes and triangles of every proportion around the unit cube: meets() never
+  // separates a triangle that meets the box, and separates most of those that do not.
+  std::mt19937 rng(11);
+  unsigned int met = 0, apart = 0, separated = 0;
+  for (unsigned int trial = 0; trial < 20000; ++trial)
+  {
+    Box b;
+    b.extend(random_point(rng, 0, 1));
+    b.extend(random_point(rng, 0, 1));
+    const double              spread = trial % 2 ? 1.5 : 0.3;
+    const cut::Point          centre = random_point(rng, 0, 1);
+    std::array<cut::Point, 3> t;
+    for (cut::Point &p : t)
+      p = cut::add(centre, random_point(rng, -spread, spread));
+    const bool meets = triangle_meets_box(t, b);
+    met += meets;
+    apart += !meets;
+    if (meets)
+      EXPECT_TRUE(b.meets(t)) << "trial " << trial;
+    else
+      separated += !b.meets(t);
+  }
+  EXPECT_GT(met, 2000u);
+  EXPECT_GT(apart, 2000u);
+  EXPECT_GT(separated, 0.95 * apart);
+}
+
+
+TEST(CutBoundaryFaceTree, SweptTriangleQueriesKeepEveryFaceTheyMeet)
+{
+  // Thin, slanted swept surfaces (as a long blade moving a little) on a deformed box:
+  // the faces whose triangle meets a swept triangle are all in the triangle query's
+  // answer, which is part of the box query's answer and far smaller than it.
+  std::mt19937        rng(13);
+  const mesh::TetMesh mesh = box_tet_mesh(8, rng);
+  std::vector<double> x(3 * mesh.n_vertices());
+  for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
+  {
+    const mesh::Point3 &r = mesh.vertex(v);
+    x[3 * v]              = r[0] + 0.1 * r[1] * r[2];
+    x[3 * v + 1]          = r[1];
+    x[3 * v + 2]          = r[2] + 0.05 * r[0];
+  }
+  BoundaryFaceTree tree;
+  tree.build(mesh, x.data());
+  std::size_t by_triangles = 0, by_box = 0;
+  for (unsigned int q = 0; q < 300; ++q)
+  {
+    const cut::Point tail = random_point(rng, -0.3, 1.3),
+                     head = random_point(rng, -0.3, 1.3);
+    const cut::Point step = cut::scale(0.02, random_point(rng, -1, 1));
+    const std::array<std::array<cut::Point, 3>, 2> swept = {
+      {{{tail, head, cut::add(tail, step)}},
+       {{cut::add(tail, step), head, cut::add(head, step)}}}};
+    std::vector<BoundaryFaceTree::Face> slim, wide;
+    tree.query(mesh, x.data(), swept, slim);
+    Box box = Box::around(swept[0]);
+    box.extend(Box::around(swept[1]));
+    tree.query(mesh, x.data(), box, wide);
+    by_triangles += slim.size();
+    by_box += wide.size();
+    std::set<FaceKey> in_slim, in_wide;
+    for (const auto &f : slim)
+      in_slim.emplace(f.tet, f.face);
+    for (const auto &f : wide)
+      in_wide.emplace(f.tet, f.face);
+    for (const FaceKey &k : in_slim)
+      EXPECT_TRUE(in_wide.count(k)) << "query " << q;
+    for (const auto &bf : mesh.get_boundary_faces())
+    {
+      const BoundaryFaceTree::Face f = {
+        bf.tet,
+        bf.face,
+        {{mesh.tet(bf.tet)[mesh::TetMesh::face_vertices[bf.face][0]],
+          mesh.tet(bf.tet)[mesh::TetMesh::face_vertices[bf.face][1]],
+          mesh.tet(bf.tet)[mesh::TetMesh::face_vertices[bf.face][2]]}}};
+      const auto triangle = BoundaryFaceTree::triangle(f, x.data());
+      if (cut::triangles_intersect(triangle, swept[0])
+          || cut::triangles_intersect(triangle, swept[1]))
+        EXPECT_TRUE(in_slim.count({bf.tet, bf.face})) << "query " << q;
+    }
+    ASSERT_FALSE(::testing::Test::HasFailure());
+  }
+  EXPECT_LT(3 * by_triangles, by_box);
 }

@@ -80,6 +80,17 @@ namespace lacerta::cut
           const Box           &box,
           std::vector<Face>   &hits) const;
 
+    /**
+     * As query() with a box, for the faces whose box meets one of @p triangles
+     * (Box::meets()): for a thin swept surface, far fewer than those whose box meets
+     * the triangles' box. Every face that meets a triangle is among them.
+     */
+    void
+    query(const mesh::TetMesh                       &mesh,
+          const double                              *x,
+          const std::array<std::array<Point, 3>, 2> &triangles,
+          std::vector<Face>                         &hits) const;
+
     /// Number of faces in the trees and the list of added faces.
     std::size_t
     size() const;
@@ -129,13 +140,24 @@ namespace lacerta::cut
     void
     fit_tree(Tree &tree) const;
 
-    /// Appends the faces of @p tree that overlap @p box and are still boundary.
+    /// Appends the faces of @p tree whose box @p meets accepts (as it accepts their
+    /// ancestors' boxes) and that are still boundary.
+    template <class Meets>
     static void
     query_tree(const Tree          &tree,
                const mesh::TetMesh &mesh,
                const double        *x,
-               const Box           &box,
+               const Meets         &meets,
                std::vector<Face>   &hits);
+
+    /// The faces of every tree and of the list whose box @p meets accepts and that are
+    /// still boundary, appended to @p hits in increasing (tet, face) order, once each.
+    template <class Meets>
+    void
+    collect(const mesh::TetMesh &mesh,
+            const double        *x,
+            const Meets         &meets,
+            std::vector<Face>   &hits) const;
 
     /// The box of @p f at positions @p x.
     static Box

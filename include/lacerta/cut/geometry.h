@@ -163,5 +163,56 @@ namespace lacerta::cut
           return false;
       return true;
     }
+
+    /**
+     * Whether triangle @p t may meet the box: false only if an axis separates them
+     * (the box's three axes, the triangle's normal, and the nine products of their
+     * edges; Akenine-Möller's test). The box is taken larger by 1e-9 of its size, so
+     * that rounding never separates a triangle that touches it.
+     */
+    bool
+    meets(const std::array<Point, 3> &t) const
+    {
+      Point centre, half;
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        centre[d] = 0.5 * (lower[d] + upper[d]);
+        half[d]   = 0.5 * (upper[d] - lower[d]);
+      }
+      const double slack = 1e-9 * std::max({half[0], half[1], half[2], 1e-300});
+      for (double &h : half)
+        h += slack;
+      const std::array<Point, 3> v = {
+        {sub(t[0], centre), sub(t[1], centre), sub(t[2], centre)}};
+      // Does the axis a separate the triangle (its vertices' projections) from the
+      // box (the projections within ± h·|a|)?
+      const auto separates = [&](const Point &a)
+      {
+        const double p0 = dot(a, v[0]), p1 = dot(a, v[1]), p2 = dot(a, v[2]);
+        const double r =
+          half[0] * std::abs(a[0]) + half[1] * std::abs(a[1]) + half[2] * std::abs(a[2]);
+        return std::min({p0, p1, p2}) > r || std::max({p0, p1, p2}) < -r;
+      };
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        Point axis{{0, 0, 0}};
+        axis[d] = 1;
+        if (separates(axis))
+          return false;
+      }
+      const std::array<Point, 3> edges = {
+        {sub(v[1], v[0]), sub(v[2], v[1]), sub(v[0], v[2])}};
+      if (separates(cross(edges[0], edges[1])))
+        return false;
+      for (const Point &e : edges)
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          Point axis{{0, 0, 0}};
+          axis[d] = 1;
+          if (separates(cross(axis, e)))
+            return false;
+        }
+      return true;
+    }
   };
 } // namespace lacerta::cut
