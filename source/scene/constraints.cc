@@ -8,6 +8,8 @@
 #include <deal.II/base/function_parser.h>
 #include <deal.II/lac/vector.h>
 
+#include <array>
+
 namespace lacerta::scene
 {
   namespace
@@ -69,10 +71,11 @@ namespace lacerta::scene
       void
       parse_parameters(dealii::ParameterHandler &prm) override
       {
-        displacement = parse_function("Constraints/Moving handle/Displacement",
+        displacement      = parse_function("Constraints/Moving handle/Displacement",
                                       prm.get("Displacement"),
                                       3,
                                       true);
+        rigid_translation = !uses_position(prm.get("Displacement"));
       }
 
       bool
@@ -86,15 +89,27 @@ namespace lacerta::scene
       {
         // One time level at a time: FunctionParser::set_time is not free, and this runs
         // at every step for every particle of the handle.
+        // A displacement that does not name x, y or z is the same for every particle:
+        // evaluated once (each evaluation of the parser looks its thread's copy up
+        // under a lock).
         const double h                  = 1e-7 * std::max(1.0, std::abs(t));
         const auto   for_each_component = [&](const double time, const auto &use)
         {
           displacement->set_time(time);
+          std::array<double, 3> u{};
+          if (rigid_translation)
+            for (unsigned int d = 0; d < 3; ++d)
+              u[d] = displacement->value(dealii::Point<3>(), d);
           for (const unsigned int i : particles)
           {
-            const dealii::Point<3> p(rest[3 * i], rest[3 * i + 1], rest[3 * i + 2]);
+            if (!rigid_translation)
+            {
+              const dealii::Point<3> p(rest[3 * i], rest[3 * i + 1], rest[3 * i + 2]);
+              for (unsigned int d = 0; d < 3; ++d)
+                u[d] = displacement->value(p, d);
+            }
             for (unsigned int d = 0; d < 3; ++d)
-              use(3 * i + d, displacement->value(p, d));
+              use(3 * i + d, u[d]);
           }
         };
         for_each_component(t,
@@ -110,6 +125,8 @@ namespace lacerta::scene
 
     private:
       std::unique_ptr<dealii::FunctionParser<3>> displacement;
+      /// Whether the displacement names none of x, y and z.
+      bool rigid_translation = false;
     };
 
 

@@ -32,6 +32,13 @@ namespace lacerta
                  const std::map<std::string, double> &constants = {});
 
   /**
+   * Whether @p expression (as given to parse_function()) names x, y or z: if not, its
+   * value is the same at every point and may be evaluated once per time.
+   */
+  bool
+  uses_position(const std::string &expression);
+
+  /**
    * The explanation a deal.II exception carries (without file, line and condition), on
    * one line.
    */
