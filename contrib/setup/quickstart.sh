@@ -25,11 +25,11 @@ case "$mode" in
     # Allow mpirun as root (CI runs as root) for the MPI tests.
     export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
     ctest --test-dir "$build" --parallel "$(nproc)" --output-on-failure --timeout 900
-    # The same suite again (but for the long scenes), built by clang with AddressSanitizer and
-    # UndefinedBehaviorSanitizer (LACERTA_SANITIZE) and libFuzzer's coverage
-    # (LACERTA_FUZZ), with the fuzz.* tests: the first report stops the test that made
-    # it. Leak checking is off (MPI and TBB keep their pools to the exit), and so is the
-    # check of new/free pairs, which libfreeimage (a dependency of deal.II's
+    # The same suite again (but for the long scenes), built by clang with
+    # AddressSanitizer and UndefinedBehaviorSanitizer (LACERTA_SANITIZE) and libFuzzer's
+    # coverage (LACERTA_FUZZ), with the fuzz.* tests: the first report stops the test
+    # that made it. Leak checking is off (MPI and TBB keep their pools to the exit), and
+    # so is the check of new/free pairs, which libfreeimage (a dependency of deal.II's
     # OpenCASCADE) breaks in its own exit handler.
     asan="${LACERTA_ASAN_BUILD_DIR:-$top/build-asan}"
     export ASAN_OPTIONS=halt_on_error=1:detect_leaks=0:alloc_dealloc_mismatch=0

@@ -27,33 +27,26 @@ namespace lacerta
   uses_position(const std::string &expression)
   {
     // The identifiers of the expression (a letter or '_', then letters, digits or
-    // '_'): a function's name, a constant, a variable.
+    // '_'); one that follows a digit or '.' is a number's exponent (1e-3).
     const auto starts = [](const char c)
     { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; };
-    const auto continues = [&](const char c)
-    { return starts(c) || std::isdigit(static_cast<unsigned char>(c)); };
+    const auto in_number = [](const char c)
+    { return std::isdigit(static_cast<unsigned char>(c)) || c == '.'; };
     for (std::size_t i = 0; i < expression.size();)
     {
-      // A number's exponent (1e-3) is not an identifier.
-      if (std::isdigit(static_cast<unsigned char>(expression[i])) || expression[i] == '.')
-      {
-        while (i < expression.size()
-               && (continues(expression[i]) || expression[i] == '.'
-                   || ((expression[i] == '-' || expression[i] == '+')
-                       && (expression[i - 1] == 'e' || expression[i - 1] == 'E'))))
-          ++i;
-        continue;
-      }
       if (!starts(expression[i]))
       {
         ++i;
         continue;
       }
       const std::size_t first = i;
-      while (i < expression.size() && continues(expression[i]))
+      while (i < expression.size()
+             && (starts(expression[i])
+                 || std::isdigit(static_cast<unsigned char>(expression[i]))))
         ++i;
       const std::string name = expression.substr(first, i - first);
-      if (name == "x" || name == "y" || name == "z")
+      if ((first == 0 || !in_number(expression[first - 1]))
+          && (name == "x" || name == "y" || name == "z"))
         return true;
     }
     return false;

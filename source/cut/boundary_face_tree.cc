@@ -85,7 +85,6 @@ namespace lacerta::cut
   BoundaryFaceTree::build(const mesh::TetMesh &mesh, const double *x)
   {
     added.clear();
-    n_added = 0;
     extra.clear();
     extra.reserve(1024);
     vertices.clear();
@@ -212,7 +211,7 @@ namespace lacerta::cut
   void
   BoundaryFaceTree::merge_added(const mesh::TetMesh &mesh, const double *x)
   {
-    if (n_added + extra.size() > boundary.faces.size())
+    if (n_added_faces() + extra.size() > boundary.faces.size())
     {
       build(mesh, x);
       return;
@@ -240,7 +239,6 @@ namespace lacerta::cut
     unsigned int k = level(faces.size());
     while (k < added.size() && !added[k].faces.empty())
     {
-      n_added -= added[k].faces.size();
       for (const Face &f : added[k].faces)
         if (still_boundary(mesh, f))
           faces.push_back(f);
@@ -249,7 +247,6 @@ namespace lacerta::cut
     }
     if (k >= added.size())
       added.resize(k + 1);
-    n_added += faces.size();
     build_tree(added[k], std::move(faces));
   }
 
@@ -289,7 +286,17 @@ namespace lacerta::cut
   std::size_t
   BoundaryFaceTree::size() const
   {
-    return boundary.faces.size() + n_added + extra.size();
+    return boundary.faces.size() + n_added_faces() + extra.size();
+  }
+
+
+  std::size_t
+  BoundaryFaceTree::n_added_faces() const
+  {
+    std::size_t n = 0;
+    for (const Tree &tree : added)
+      n += tree.faces.size();
+    return n;
   }
 
 

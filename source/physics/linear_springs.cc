@@ -10,13 +10,6 @@ namespace lacerta::physics
 {
   namespace
   {
-    /**
-     * Adds the forces of springs [begin, end) to f. Spring s pulls a[s] towards b[s]
-     * with k (L - L0) (plus β k (dv·n) along the spring if Damped). If BothEnds is
-     * false only the end a[s] is written: the spring crosses into another thread's
-     * particles, which computes it too and writes its own end. If Prefetch, the far
-     * ends' positions (and forces) are fetched a few springs ahead.
-     */
     /// How many springs ahead add_spring_forces() fetches the far ends' data.
     constexpr std::size_t prefetch_distance = 64;
 
@@ -24,6 +17,13 @@ namespace lacerta::physics
     /// outgrow a second-level cache of 1 MiB, so that fetching ahead pays.
     constexpr std::size_t prefetch_particles = 1u << 15;
 
+    /**
+     * Adds the forces of springs [begin, end) to f. Spring s pulls a[s] towards b[s]
+     * with k (L - L0) (plus β k (dv·n) along the spring if Damped). If BothEnds is
+     * false only the end a[s] is written: the spring crosses into another thread's
+     * particles, which computes it too and writes its own end. If Prefetch, the far
+     * ends' positions (and forces) are fetched a few springs ahead.
+     */
     template <bool Damped, bool BothEnds, bool Prefetch>
     inline void
     add_spring_forces(const SpringSet  &springs,

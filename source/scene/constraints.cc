@@ -88,26 +88,25 @@ namespace lacerta::scene
       prescribe(const double t, const double *rest, double *x, double *v) const override
       {
         // One time level at a time: FunctionParser::set_time is not free, and this runs
-        // at every step for every particle of the handle.
-        // A displacement that does not name x, y or z is the same for every particle:
-        // evaluated once (each evaluation of the parser looks its thread's copy up
-        // under a lock).
+        // at every step for every particle of the handle. A displacement that names
+        // none of x, y and z is the same for every particle: evaluated once (each
+        // evaluation of the parser looks its thread's copy up under a lock).
         const double h                  = 1e-7 * std::max(1.0, std::abs(t));
         const auto   for_each_component = [&](const double time, const auto &use)
         {
           displacement->set_time(time);
           std::array<double, 3> u{};
-          if (rigid_translation)
+          const auto            evaluate = [&](const dealii::Point<3> &p)
+          {
             for (unsigned int d = 0; d < 3; ++d)
-              u[d] = displacement->value(dealii::Point<3>(), d);
+              u[d] = displacement->value(p, d);
+          };
+          if (rigid_translation)
+            evaluate(dealii::Point<3>());
           for (const unsigned int i : particles)
           {
             if (!rigid_translation)
-            {
-              const dealii::Point<3> p(rest[3 * i], rest[3 * i + 1], rest[3 * i + 2]);
-              for (unsigned int d = 0; d < 3; ++d)
-                u[d] = displacement->value(p, d);
-            }
+              evaluate(dealii::Point<3>(rest[3 * i], rest[3 * i + 1], rest[3 * i + 2]));
             for (unsigned int d = 0; d < 3; ++d)
               use(3 * i + d, u[d]);
           }

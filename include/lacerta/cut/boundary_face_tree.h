@@ -171,6 +171,10 @@ namespace lacerta::cut
     void
     track(unsigned int v, const double *x);
 
+    /// Number of faces in the trees of added faces.
+    std::size_t
+    n_added_faces() const;
+
     /// Turns the list of added faces into a tree of the logarithmic method.
     void
     merge_added(const mesh::TetMesh &mesh, const double *x);
@@ -181,8 +185,6 @@ namespace lacerta::cut
     std::vector<Tree> added;
     /// Added faces not yet in a tree.
     std::vector<Face> extra;
-    /// Faces in `added`.
-    std::size_t n_added = 0;
 
     std::vector<Entry>  work;
     std::vector<double> sizes;

@@ -193,25 +193,18 @@ namespace lacerta::cut
           half[0] * std::abs(a[0]) + half[1] * std::abs(a[1]) + half[2] * std::abs(a[2]);
         return std::min({p0, p1, p2}) > r || std::max({p0, p1, p2}) < -r;
       };
-      for (unsigned int d = 0; d < 3; ++d)
-      {
-        Point axis{{0, 0, 0}};
-        axis[d] = 1;
+      const std::array<Point, 3> axes = {{{{1, 0, 0}}, {{0, 1, 0}}, {{0, 0, 1}}}};
+      for (const Point &axis : axes)
         if (separates(axis))
           return false;
-      }
       const std::array<Point, 3> edges = {
         {sub(v[1], v[0]), sub(v[2], v[1]), sub(v[0], v[2])}};
       if (separates(cross(edges[0], edges[1])))
         return false;
       for (const Point &e : edges)
-        for (unsigned int d = 0; d < 3; ++d)
-        {
-          Point axis{{0, 0, 0}};
-          axis[d] = 1;
+        for (const Point &axis : axes)
           if (separates(cross(axis, e)))
             return false;
-        }
       return true;
     }
   };
