@@ -205,6 +205,19 @@ namespace lacerta::physics
         }
       }
 
+      void
+      for_each_element_stiffness_of(
+        const ParticleSystem                                              &system,
+        const double                                                      *x,
+        const std::vector<unsigned int>                                   &list,
+        const std::function<void(unsigned int, const ElementStiffness &)> &visit)
+        const override
+      {
+        tets.for_each_copy_of(list,
+                              [&](unsigned int t, unsigned int p, std::size_t c)
+                              { visit(t, rotated_stiffness(*system.mesh, p, c, x)); });
+      }
+
     private:
       /**
        * The stress P of copy @p c: 2μ (F - R) + λ tr(RᵀF - I) R, plus with β > 0 the

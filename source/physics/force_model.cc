@@ -25,6 +25,16 @@ namespace lacerta::physics
 
 
   void
+  ForceModel::for_each_element_stiffness_of(
+    const ParticleSystem &,
+    const double *,
+    const std::vector<unsigned int> &,
+    const std::function<void(unsigned int, const ElementStiffness &)> &) const
+  {
+  }
+
+
+  void
   ForceModel::declare_parameters(dealii::ParameterHandler &prm)
   {
     ForceModelRegistry::declare_selector_subsection(

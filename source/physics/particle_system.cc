@@ -43,6 +43,7 @@ namespace lacerta::physics
     // Body forces add their acceleration when initialised again on the new particles.
     body_acceleration = {{0, 0, 0}};
     rest              = rest_positions;
+    changed.clear();
   }
 
 
@@ -73,15 +74,21 @@ namespace lacerta::physics
 
 
   void
-  ParticleSystem::springs_changed(const std::vector<unsigned int> &changed)
+  ParticleSystem::springs_changed(const std::vector<unsigned int> &changed_springs)
   {
-    forces->springs_changed(*this, changed);
+    for (const unsigned int s : changed_springs)
+    {
+      changed.push_back(springs.a[s]);
+      changed.push_back(springs.b[s]);
+    }
+    forces->springs_changed(*this, changed_springs);
   }
 
 
   void
   ParticleSystem::masses_changed(const std::vector<unsigned int> &particles)
   {
+    changed.insert(changed.end(), particles.begin(), particles.end());
     forces->masses_changed(*this, particles);
   }
 
@@ -101,6 +108,7 @@ namespace lacerta::physics
     mass.push_back(0.0);
     mass_shift.push_back(0.0);
     free.push_back(1.0);
+    changed.push_back(n_particles() - 1);
     return n_particles() - 1;
   }
 

@@ -27,9 +27,11 @@ namespace lacerta::physics
       void
       initialize(const ParticleSystem &system) override
       {
+        // Every stage writes its arrays before reading them: growing them is enough,
+        // and costs the new particles only (nothing global per cut).
         const std::size_t n = system.position.size();
         for (auto *v : {&x_stage, &v_stage, &a_stage, &dx_sum, &dv_sum})
-          v->assign(n, 0.0);
+          v->resize(n);
       }
 
       void

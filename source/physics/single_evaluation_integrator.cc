@@ -12,7 +12,9 @@ namespace lacerta::physics
   void
   SingleEvaluationIntegrator::initialize(const ParticleSystem &system)
   {
-    acceleration.assign(system.position.size(), 0.0);
+    // Every step computes the accelerations before reading them: growing the array is
+    // enough, and costs the new particles only (nothing global per cut).
+    acceleration.resize(system.position.size());
   }
 
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <sstream>
 
 namespace lacerta::physics
 {
@@ -67,48 +68,78 @@ namespace lacerta::physics
 
 
     /**
-     * Adds the terms of the force model's per-tetrahedron stiffness (if it has any) to
-     * the diagonal @p blocks and to the @p pair_norm of every spring (mesh edge): the
-     * diagonal blocks of each element stiffness, and the spectral norm of each
-     * off-diagonal block to the spring of its edge.
+     * The tangent stiffness K_e = (k - g) n nᵀ + g I of spring @p s at positions @p x
+     * (k its stiffness times @p scale, g = k (1 - L0/L) the geometric stiffness) as a
+     * symmetric block, and in @p norm the bound max(k, |g|) of ||K_e||.
      */
-    void
-    add_element_terms(const ParticleSystem               &system,
-                      const double                       *x,
-                      std::vector<std::array<double, 6>> &blocks,
-                      std::vector<double>                &pair_norm)
+    std::array<double, 6>
+    spring_tangent_block(const SpringSet  &springs,
+                         const std::size_t s,
+                         const double     *x,
+                         const double      scale,
+                         double           &norm)
     {
-      system.force_model().for_each_element_stiffness(
-        system,
-        x,
-        [&](const unsigned int t, const ForceModel::ElementStiffness &K)
-        {
-          const mesh::Tet &tet = system.mesh->tet(t);
-          const auto       at =
-            [&](unsigned int a, unsigned int r, unsigned int b, unsigned int c)
-          { return K[12 * (3 * a + r) + 3 * b + c]; };
-          for (unsigned int a = 0; a < 4; ++a)
-            add_block(blocks[tet[a]],
-                      {at(a, 0, a, 0),
-                       at(a, 1, a, 1),
-                       at(a, 2, a, 2),
-                       0.5 * (at(a, 0, a, 1) + at(a, 1, a, 0)),
-                       0.5 * (at(a, 0, a, 2) + at(a, 2, a, 0)),
-                       0.5 * (at(a, 1, a, 2) + at(a, 2, a, 1))});
-          for (unsigned int e = 0; e < 6; ++e)
-          {
-            const auto [a, b] = mesh::TetMesh::edge_vertices[e];
-            // ||K_ab||² = λ_max(K_abᵀ K_ab).
-            std::array<double, 6> gram{};
-            const unsigned int    pairs[6][2] = {
-                 {0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
-            for (unsigned int g = 0; g < 6; ++g)
-              for (unsigned int r = 0; r < 3; ++r)
-                gram[g] += at(a, r, b, pairs[g][0]) * at(a, r, b, pairs[g][1]);
-            pair_norm[system.mesh->tet_edges(t)[e]] +=
-              std::sqrt(std::max(0.0, largest_eigenvalue(gram)));
-          }
-        });
+      const unsigned int i = springs.a[s], j = springs.b[s];
+      double             d[3]   = {x[3 * j] - x[3 * i],
+                                   x[3 * j + 1] - x[3 * i + 1],
+                                   x[3 * j + 2] - x[3 * i + 2]};
+      const double       length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      for (double &c : d)
+        c /= length;
+      const double k         = scale * springs.stiffness[s];
+      const double geometric = k * (1.0 - springs.rest_length[s] / length);
+      norm                   = std::max(k, std::abs(geometric));
+      return {(k - geometric) * d[0] * d[0] + geometric,
+              (k - geometric) * d[1] * d[1] + geometric,
+              (k - geometric) * d[2] * d[2] + geometric,
+              (k - geometric) * d[0] * d[1],
+              (k - geometric) * d[0] * d[2],
+              (k - geometric) * d[1] * d[2]};
+    }
+
+
+    /**
+     * The Gershgorin terms of one element stiffness @p K: calls @p diagonal(a, block)
+     * with the symmetric part of the diagonal block of each local vertex a, and
+     * @p off_diagonal(e, norm) with the spectral norm of the off-diagonal block of each
+     * local edge e.
+     */
+    template <typename Diagonal, typename OffDiagonal>
+    void
+    element_terms(const ForceModel::ElementStiffness &K,
+                  const Diagonal                     &diagonal,
+                  const OffDiagonal                  &off_diagonal)
+    {
+      const auto at = [&](unsigned int a, unsigned int r, unsigned int b, unsigned int c)
+      { return K[12 * (3 * a + r) + 3 * b + c]; };
+      for (unsigned int a = 0; a < 4; ++a)
+        diagonal(a,
+                 std::array<double, 6>{at(a, 0, a, 0),
+                                       at(a, 1, a, 1),
+                                       at(a, 2, a, 2),
+                                       0.5 * (at(a, 0, a, 1) + at(a, 1, a, 0)),
+                                       0.5 * (at(a, 0, a, 2) + at(a, 2, a, 0)),
+                                       0.5 * (at(a, 1, a, 2) + at(a, 2, a, 1))});
+      for (unsigned int e = 0; e < 6; ++e)
+      {
+        const auto [a, b] = mesh::TetMesh::edge_vertices[e];
+        // ||K_ab||² = λ_max(K_abᵀ K_ab).
+        std::array<double, 6> gram{};
+        const unsigned int pairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+        for (unsigned int g = 0; g < 6; ++g)
+          for (unsigned int r = 0; r < 3; ++r)
+            gram[g] += at(a, r, b, pairs[g][0]) * at(a, r, b, pairs[g][1]);
+        off_diagonal(e, std::sqrt(std::max(0.0, largest_eigenvalue(gram))));
+      }
+    }
+
+
+    /// The factor the force model applies to the springs (1 without a model).
+    double
+    spring_scale(const ParticleSystem &system)
+    {
+      return system.has_force_model() ? system.force_model().spring_stiffness_scale()
+                                      : 1.0;
     }
   } // namespace
 
@@ -120,8 +151,7 @@ namespace lacerta::physics
     const SpringSet   &springs = system.springs;
     // A system without a force model yet (a bare spring network) is bounded by its
     // springs as they are.
-    const double scale =
-      system.has_force_model() ? system.force_model().spring_stiffness_scale() : 1.0;
+    const double                       scale = spring_scale(system);
     std::vector<std::array<double, 6>> blocks(n, std::array<double, 6>{});
     std::vector<double>                pair_norm(springs.size(), 0.0);
     GershgorinTerms                    terms;
@@ -131,28 +161,25 @@ namespace lacerta::physics
 
     for (std::size_t s = 0; s < springs.size(); ++s)
     {
-      const unsigned int i = springs.a[s], j = springs.b[s];
-      double             d[3]   = {x[3 * j] - x[3 * i],
-                                   x[3 * j + 1] - x[3 * i + 1],
-                                   x[3 * j + 2] - x[3 * i + 2]};
-      const double       length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      for (double &c : d)
-        c /= length;
-      const double k         = scale * springs.stiffness[s];
-      const double geometric = k * (1.0 - springs.rest_length[s] / length);
-      // K_e = (k - g) n nᵀ + g I, g the geometric stiffness.
-      const std::array<double, 6> block = {(k - geometric) * d[0] * d[0] + geometric,
-                                           (k - geometric) * d[1] * d[1] + geometric,
-                                           (k - geometric) * d[2] * d[2] + geometric,
-                                           (k - geometric) * d[0] * d[1],
-                                           (k - geometric) * d[0] * d[2],
-                                           (k - geometric) * d[1] * d[2]};
-      pair_norm[s]                      = std::max(k, std::abs(geometric));
-      add_block(blocks[i], block);
-      add_block(blocks[j], block);
+      const std::array<double, 6> block =
+        spring_tangent_block(springs, s, x, scale, pair_norm[s]);
+      add_block(blocks[springs.a[s]], block);
+      add_block(blocks[springs.b[s]], block);
     }
     if (system.has_force_model())
-      add_element_terms(system, x, blocks, pair_norm);
+      system.force_model().for_each_element_stiffness(
+        system,
+        x,
+        [&](const unsigned int t, const ForceModel::ElementStiffness &K)
+        {
+          const mesh::Tet &tet = system.mesh->tet(t);
+          element_terms(
+            K,
+            [&](unsigned int a, const std::array<double, 6> &b)
+            { add_block(blocks[tet[a]], b); },
+            [&](unsigned int e, double norm)
+            { pair_norm[system.mesh->tet_edges(t)[e]] += norm; });
+        });
 
     std::vector<double> stiffest(n, 0.0);
     for (std::size_t s = 0; s < springs.size(); ++s)
@@ -173,37 +200,145 @@ namespace lacerta::physics
   }
 
 
-  namespace
+  void
+  gershgorin_rows(const ParticleSystem            &system,
+                  const double                    *x,
+                  const std::vector<unsigned int> &rows,
+                  GershgorinRowScratch            &scratch,
+                  double                          *lambda,
+                  unsigned int                    *stiffest_spring)
   {
-    /// The squares of particle_frequency_bounds() from the system's Gershgorin
-    /// @p terms.
-    std::vector<double>
-    squared_frequencies(const ParticleSystem &system, const GershgorinTerms &terms)
+    const mesh::TetMesh  &mesh    = *system.mesh;
+    const SpringSet      &springs = system.springs;
+    GershgorinRowScratch &w       = scratch;
+    ++w.stamp;
+    w.row_of.resize(system.n_particles(), 0);
+    w.row_stamp.resize(system.n_particles(), 0);
+    w.spring_stamp.resize(springs.size(), 0);
+    w.spring_of.resize(springs.size(), 0);
+    w.tet_stamp.resize(mesh.n_tets(), 0);
+    for (std::size_t r = 0; r < rows.size(); ++r)
     {
-      const unsigned int  n = system.n_particles();
-      std::vector<double> off_diagonal(n, 0.0);
-      for (std::size_t s = 0; s < system.springs.size(); ++s)
-        if (terms.coupling[s] > 0)
-        {
-          const unsigned int i = system.springs.a[s], j = system.springs.b[s];
-          const double c = terms.coupling[s] / std::sqrt(system.mass[i] * system.mass[j]);
-          off_diagonal[i] += c;
-          off_diagonal[j] += c;
-        }
-      std::vector<double> lambda(n, 0.0);
-      for (unsigned int i = 0; i < n; ++i)
-        if (system.free[i] > 0 && system.mass[i] > 0)
-          lambda[i] = terms.diagonal[i] / system.mass[i] + off_diagonal[i];
-      return lambda;
+      w.row_stamp[rows[r]] = w.stamp;
+      w.row_of[rows[r]]    = static_cast<unsigned int>(r);
     }
-  } // namespace
+    const auto is_row = [&](const unsigned int p) { return w.row_stamp[p] == w.stamp; };
+    // The tetrahedra around the rows, and the springs (edges) at the rows.
+    w.tets.clear();
+    w.springs.clear();
+    for (const unsigned int p : rows)
+      for (const unsigned int t : mesh.tets_of_vertex(p))
+      {
+        if (w.tet_stamp[t] == w.stamp)
+          continue;
+        w.tet_stamp[t] = w.stamp;
+        w.tets.push_back(t);
+        for (const unsigned int s : mesh.tet_edges(t))
+          if (w.spring_stamp[s] != w.stamp
+              && (is_row(springs.a[s]) || is_row(springs.b[s])))
+          {
+            w.spring_stamp[s] = w.stamp;
+            w.springs.push_back(s);
+          }
+      }
+    // In spring order, so that the stiffest spring is chosen as gershgorin_terms()
+    // chooses it among equals.
+    std::sort(w.springs.begin(), w.springs.end());
+    for (std::size_t k = 0; k < w.springs.size(); ++k)
+      w.spring_of[w.springs[k]] = static_cast<unsigned int>(k);
+    w.blocks.assign(rows.size(), std::array<double, 6>{});
+    w.pair_norm.assign(w.springs.size(), 0.0);
+    const double scale = spring_scale(system);
+    for (std::size_t k = 0; k < w.springs.size(); ++k)
+    {
+      const unsigned int          s = w.springs[k];
+      const std::array<double, 6> block =
+        spring_tangent_block(springs, s, x, scale, w.pair_norm[k]);
+      for (const unsigned int p : {springs.a[s], springs.b[s]})
+        if (is_row(p))
+          add_block(w.blocks[w.row_of[p]], block);
+    }
+    if (system.has_force_model())
+      system.force_model().for_each_element_stiffness_of(
+        system,
+        x,
+        w.tets,
+        [&](const unsigned int t, const ForceModel::ElementStiffness &K)
+        {
+          const mesh::Tet &tet = mesh.tet(t);
+          element_terms(
+            K,
+            [&](unsigned int a, const std::array<double, 6> &b)
+            {
+              if (is_row(tet[a]))
+                add_block(w.blocks[w.row_of[tet[a]]], b);
+            },
+            [&](unsigned int e, double norm)
+            {
+              const unsigned int s = mesh.tet_edges(t)[e];
+              if (w.spring_stamp[s] == w.stamp)
+                w.pair_norm[w.spring_of[s]] += norm;
+            });
+        });
+    // The rows, as squared_frequency_bounds() makes them from gershgorin_terms().
+    w.off_diagonal.assign(rows.size(), 0.0);
+    w.stiffest.assign(rows.size(), 0.0);
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      stiffest_spring[r] = 0;
+    for (std::size_t k = 0; k < w.springs.size(); ++k)
+    {
+      const unsigned int s = w.springs[k], i = springs.a[s], j = springs.b[s];
+      const bool coupled = system.free[i] > 0 && system.free[j] > 0 && w.pair_norm[k] > 0;
+      const double c =
+        coupled ? w.pair_norm[k] / std::sqrt(system.mass[i] * system.mass[j]) : 0.0;
+      for (const unsigned int p : {i, j})
+        if (is_row(p))
+        {
+          const unsigned int r = w.row_of[p];
+          w.off_diagonal[r] += c;
+          if (w.pair_norm[k] > w.stiffest[r])
+          {
+            w.stiffest[r]      = w.pair_norm[k];
+            stiffest_spring[r] = s;
+          }
+        }
+    }
+    for (std::size_t r = 0; r < rows.size(); ++r)
+    {
+      const unsigned int i = rows[r];
+      lambda[r]            = system.free[i] > 0 && system.mass[i] > 0
+                               ? largest_eigenvalue(w.blocks[r]) / system.mass[i] + w.off_diagonal[r]
+                               : 0.0;
+    }
+  }
+
+
+  std::vector<double>
+  squared_frequency_bounds(const ParticleSystem &system, const GershgorinTerms &terms)
+  {
+    const unsigned int  n = system.n_particles();
+    std::vector<double> off_diagonal(n, 0.0);
+    for (std::size_t s = 0; s < system.springs.size(); ++s)
+      if (terms.coupling[s] > 0)
+      {
+        const unsigned int i = system.springs.a[s], j = system.springs.b[s];
+        const double c = terms.coupling[s] / std::sqrt(system.mass[i] * system.mass[j]);
+        off_diagonal[i] += c;
+        off_diagonal[j] += c;
+      }
+    std::vector<double> lambda(n, 0.0);
+    for (unsigned int i = 0; i < n; ++i)
+      if (system.free[i] > 0 && system.mass[i] > 0)
+        lambda[i] = terms.diagonal[i] / system.mass[i] + off_diagonal[i];
+    return lambda;
+  }
 
 
   std::vector<double>
   particle_frequency_bounds(const ParticleSystem &system)
   {
     std::vector<double> omega =
-      squared_frequencies(system, gershgorin_terms(system, system.position.data()));
+      squared_frequency_bounds(system, gershgorin_terms(system, system.position.data()));
     for (double &w : omega)
       w = std::sqrt(w);
     return omega;
@@ -214,7 +349,7 @@ namespace lacerta::physics
   bound_highest_frequency(const ParticleSystem &system)
   {
     const GershgorinTerms     terms  = gershgorin_terms(system, system.position.data());
-    const std::vector<double> lambda = squared_frequencies(system, terms);
+    const std::vector<double> lambda = squared_frequency_bounds(system, terms);
     FrequencyBound            bound;
     double                    largest = 0;
     for (unsigned int i = 0; i < lambda.size(); ++i)
@@ -315,12 +450,14 @@ namespace lacerta::physics
 
 
   void
-  BlowUpMonitor::check_finite(const ParticleSystem &system,
-                              const unsigned int    step,
-                              const double          time,
-                              const std::string    &after) const
+  BlowUpMonitor::check_finite(const ParticleSystem            &system,
+                              const std::vector<unsigned int> *particles,
+                              const unsigned int               step,
+                              const double                     time,
+                              const std::string               &after) const
   {
-    for (unsigned int i = 0; i < system.n_particles(); ++i)
+    const auto check = [&](const unsigned int i)
+    {
       for (unsigned int d = 0; d < 3; ++d)
         if (!std::isfinite(system.position[3 * i + d])
             || !std::isfinite(system.velocity[3 * i + d]))
@@ -334,6 +471,13 @@ namespace lacerta::physics
                       describe_particle(system, i),
                       " has a position or velocity that is not a finite number. Reduce "
                       "'Time step' or raise 'Stability/Safety factor' margin.");
+    };
+    if (particles != nullptr)
+      for (const unsigned int i : *particles)
+        check(i);
+    else
+      for (unsigned int i = 0; i < system.n_particles(); ++i)
+        check(i);
   }
 
 
@@ -394,7 +538,9 @@ namespace lacerta::physics
                        const unsigned int    step,
                        const double          time)
   {
-    check_finite(system, step, time, "");
+    const std::string after =
+      pending_change.empty() ? std::string() : " (since " + pending_change + ")";
+    check_finite(system, nullptr, step, time, after);
 
     compute_load_forces(system);
     const std::vector<double> &x = system.position;
@@ -407,7 +553,36 @@ namespace lacerta::physics
     // the state under test, the excess could never exceed it with a tolerance of 1
     // (the default), and a run reached 1e127 J unstopped.
     energy_scale =
-      std::max(energy_scale, check_energy(system, step, time, "") + std::abs(work));
+      std::max(energy_scale, check_energy(system, step, time, after) + std::abs(work));
+    if (!pending_change.empty())
+    {
+      // The rest of restart() for the local changes since the last check: the ledger
+      // starts again from this state (see restart()).
+      energy_floor = std::max(energy_floor, noise_energy(system));
+      start_ledger(system);
+      pending_change.clear();
+    }
+  }
+
+
+  void
+  BlowUpMonitor::note_local_change(const ParticleSystem            &system,
+                                   const std::vector<unsigned int> &changed,
+                                   const unsigned int               step,
+                                   const double                     time,
+                                   const std::string               &cause)
+  {
+    std::ostringstream what;
+    what << cause << " at step " << step << ", time " << time << " s";
+    check_finite(system, &changed, step, time, " (right after " + cause + ")");
+    // New particles enter the work of the loads from where they are now.
+    const std::size_t n = system.position.size();
+    for (std::size_t c = previous_position.size(); c < n; ++c)
+      previous_position.push_back(system.position[c]);
+    previous_load.resize(n, 0.0);
+    load.resize(n, 0.0);
+    if (pending_change.empty())
+      pending_change = what.str();
   }
 
 
@@ -418,7 +593,8 @@ namespace lacerta::physics
                          const std::string    &cause)
   {
     const std::string after = " (right after " + cause + ")";
-    check_finite(system, step, time, after);
+    pending_change.clear();
+    check_finite(system, nullptr, step, time, after);
     energy_floor = std::max(energy_floor, noise_energy(system));
     energy_scale = std::max(energy_scale, check_energy(system, step, time, after));
     // The ledger starts again from the new state: the work of the loads since the

@@ -198,13 +198,35 @@ namespace lacerta::physics
           const PartitionedTets::Part &part = tets.part(p);
           for (std::size_t c = 0; c < part.size(); ++c)
             if (part.owned[c] & 1u)
-              visit(part.tet[c],
-                    parameters.volume_modulus > 0 ? volume_term_stiffness(part, c, x)
-                                                  : shear_term_stiffness(part, c, x));
+              visit(part.tet[c], element_stiffness(part, c, x));
         }
       }
 
+      void
+      for_each_element_stiffness_of(
+        const ParticleSystem &,
+        const double                                                      *x,
+        const std::vector<unsigned int>                                   &list,
+        const std::function<void(unsigned int, const ElementStiffness &)> &visit)
+        const override
+      {
+        tets.for_each_copy_of(list,
+                              [&](unsigned int t, unsigned int p, std::size_t c)
+                              { visit(t, element_stiffness(tets.part(p), c, x)); });
+      }
+
     private:
+      /// The tangent stiffness of copy @p c's term at @p x (the volume term, or the
+      /// shear term below the lattice's Poisson ratio).
+      ElementStiffness
+      element_stiffness(const PartitionedTets::Part &part,
+                        const std::size_t            c,
+                        const double                *x) const
+      {
+        return parameters.volume_modulus > 0 ? volume_term_stiffness(part, c, x)
+                                             : shear_term_stiffness(part, c, x);
+      }
+
       /// The energy of copy @p c's term at @p x.
       double
       element_energy(const PartitionedTets::Part &part,

@@ -11,6 +11,7 @@
 #include <lacerta/physics/mass_balancer.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/stability.h>
+#include <lacerta/physics/stability_bound.h>
 #include <lacerta/postprocess/postprocessor.h>
 #include <lacerta/scene/scene.h>
 #include <lacerta/simulator/simulator.h>
@@ -326,10 +327,10 @@ namespace lacerta
 
 
   unsigned int
-  Simulator::choose_substeps(const unsigned int current)
+  Simulator::choose_substeps(const physics::FrequencyBound &bound,
+                             const unsigned int             current)
   {
     const physics::ParticleSystem &system = *scene->system;
-    const physics::FrequencyBound  bound  = physics::bound_highest_frequency(system);
     if (bound.omega == 0)
       return current > 0 ? current : 1;
     if (!std::isfinite(bound.omega))
@@ -450,11 +451,14 @@ namespace lacerta
       scene->multiresolution->print_summary(std::cout, test_mode);
     std::cout << "Integrator: "
               << "time step " << time_step << " s, end time " << end_time << " s\n";
-    timer          = std::make_unique<dealii::TimerOutput>(std::cout,
+    timer           = std::make_unique<dealii::TimerOutput>(std::cout,
                                                   dealii::TimerOutput::never,
                                                   dealii::TimerOutput::wall_times);
-    state          = postprocess::RunState();
-    state.substeps = choose_substeps();
+    state           = postprocess::RunState();
+    stability_bound = std::make_unique<physics::StabilityBound>();
+    stability_bound->compute(system);
+    system.clear_changes();
+    state.substeps = choose_substeps(stability_bound->bound());
     if (scene->multiresolution)
       print_stability_against_full_mesh();
     monitor = std::make_unique<physics::BlowUpMonitor>(system, energy_tolerance);
@@ -498,19 +502,22 @@ namespace lacerta
     std::optional<cut::Blade>  blade;
     if (signals.blade)
       blade = signals.blade(time + dt);
+    change_seconds = 0;
     const cut::CutStepStatistics cut =
       scene->cut(blade ? *blade : scene->tool->blade(time + dt), time);
-    state.cut_tets         = cut.cut_tets;
-    state.created_tets     = cut.created_tets;
-    state.update_seconds   = cut.update_seconds;
-    state.cut_step_seconds = cut.search_seconds + cut.update_seconds + cut.reinit_seconds;
+    state.cut_tets       = cut.cut_tets;
+    state.created_tets   = cut.created_tets;
+    state.update_seconds = cut.update_seconds;
+    state.cut_step_seconds =
+      cut.search_seconds + cut.update_seconds + cut.reinit_seconds + change_seconds;
   }
 
 
   void
   Simulator::lacerate()
   {
-    dealii::TimerOutput::Scope      scope(*timer, "laceration");
+    dealii::TimerOutput::Scope scope(*timer, "laceration");
+    change_seconds                       = 0;
     const cut::LacerationStatistics tear = scene->lacerate(time);
     state.over_limit                     = tear.over_limit;
     if (!tear.changed)
@@ -518,7 +525,7 @@ namespace lacerta
     state.tears             = 1;
     state.torn_tets         = tear.cut_tets;
     state.tear_created_tets = tear.created_tets;
-    state.tear_seconds      = tear.update_seconds;
+    state.tear_seconds      = tear.update_seconds + change_seconds;
   }
 
 
@@ -560,6 +567,7 @@ namespace lacerta
   void
   Simulator::on_system_changed(const scene::SystemChange &change)
   {
+    const auto               start  = Clock::now();
     physics::ParticleSystem &system = *scene->system;
     if (mass_balancer)
     {
@@ -572,12 +580,28 @@ namespace lacerta
     if (change.cause != scene::SystemChange::Cause::level_of_detail)
       check(step);
     integrator->initialize(system);
-    // The blow-up monitor checks the new state against its ledger at once, so that a
-    // change that puts particles far off stops the run naming it, then restarts.
-    monitor->restart(system, step, change.time, change.describe());
-    state.substeps = choose_substeps();
+    if (change.reassembled())
+    {
+      // Every particle is new: the blow-up monitor checks the new state against its
+      // ledger at once, so that a change that puts particles far off stops the run
+      // naming it, then restarts; the bound is computed anew.
+      monitor->restart(system, step, change.time, change.describe());
+      stability_bound->compute(system);
+    }
+    else
+    {
+      // A local change is followed locally (nothing global per cut): the changed
+      // particles are checked now and the ledger restarts at the next check; the
+      // bound is computed again around the changed particles.
+      monitor->note_local_change(
+        system, system.changed_particles(), step, change.time, change.describe());
+      stability_bound->update(system, system.changed_particles());
+    }
+    system.clear_changes();
+    state.substeps = choose_substeps(stability_bound->bound());
     state.mesh     = &scene->active_mesh();
     state.blade    = scene->cutter ? &scene->cutter->blade() : nullptr;
+    change_seconds += seconds_since(start);
   }
 
 
@@ -623,7 +647,10 @@ namespace lacerta
       // strongly compressed spring) without any change of the system: keeping the
       // sub-steps chosen at the last change let the severed kidney pole blow up.
       if (substep_when_unstable)
-        state.substeps = choose_substeps(state.substeps);
+      {
+        stability_bound->compute(system);
+        state.substeps = choose_substeps(stability_bound->bound(), state.substeps);
+      }
     }
     if (needs_energies)
     {

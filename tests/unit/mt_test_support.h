@@ -17,6 +17,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <sstream>
 #include <string>
 
 namespace lacerta::test_support
@@ -37,6 +38,34 @@ namespace lacerta::test_support
     Simulator::read_parameters(file, prm);
     std::filesystem::remove(file);
     return std::make_unique<scene::Scene>(prm, n_threads);
+  }
+
+
+  /**
+   * The slab of square_lod.prm at 6 x 6 x 2 boxes without multiresolution, at
+   * Poisson ratio 0.4 with force model @p model on @p n_threads threads, and a scalpel
+   * spanning its thickness that goes from (x0, y0) at t = 0 to (x1, y1) at t = 1 s.
+   */
+  inline std::unique_ptr<scene::Scene>
+  slab_cut_scene(const std::string &model,
+                 const double       x0,
+                 const double       y0,
+                 const double       x1,
+                 const double       y1,
+                 const unsigned int n_threads = 1)
+  {
+    std::ostringstream text;
+    text << "include " LACERTA_SCENE_DIR "/square_lod.prm\n"
+         << "subsection Mesh\n  subsection Box\n    set Repetitions = 6, 6, 2\n"
+         << "  end\nend\n"
+         << "subsection Multiresolution\n  set Enabled = false\nend\n"
+         << "subsection Material\n  set Poisson ratio = 0.4\nend\n"
+         << "subsection Force model\n  set Model = " << model << "\nend\n"
+         << "subsection Tool\n  set Type = scalpel\n  subsection Scalpel\n"
+         << "    set Keyframes = 0, " << x0 << ", " << y0 << ", 0.03, " << x0 << ", "
+         << y0 << ", -0.01; 1, " << x1 << ", " << y1 << ", 0.03, " << x1 << ", " << y1
+         << ", -0.01\n  end\nend\n";
+    return scene_from_text("lacerta_slab_cut.prm", text.str(), n_threads);
   }
 
 

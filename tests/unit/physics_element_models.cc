@@ -304,18 +304,8 @@ TEST(ElementModels, RunThroughACutAndStayAtRestThere)
   for (const std::string &model : element_models)
     for (const unsigned int threads : {1u, 2u})
     {
-      std::ostringstream text;
-      text << "include " LACERTA_SCENE_DIR "/square_lod.prm\n"
-           << "subsection Mesh\n  subsection Box\n    set Repetitions = 6, 6, 2\n"
-           << "  end\nend\n"
-           << "subsection Multiresolution\n  set Enabled = false\nend\n"
-           << "subsection Material\n  set Poisson ratio = 0.4\nend\n"
-           << "subsection Force model\n  set Model = " << model << "\nend\n"
-           << "subsection Tool\n  set Type = scalpel\n  subsection Scalpel\n"
-           << "    set Keyframes = 0, 0.003, 0.07, 0.03, 0.003, 0.07, -0.01; "
-              "1, 0.003, -0.07, 0.03, 0.003, -0.07, -0.01\n  end\nend\n";
       auto scene =
-        test_support::scene_from_text("lacerta_element_cut.prm", text.str(), threads);
+        test_support::slab_cut_scene(model, 0.003, 0.07, 0.003, -0.07, threads);
       physics::ParticleSystem &system = *scene->system;
       const unsigned int       before = scene->mesh.n_tets();
       for (unsigned int k = 1; k <= 20; ++k)

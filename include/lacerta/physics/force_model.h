@@ -112,6 +112,19 @@ namespace lacerta::physics
       const double                                                      *x,
       const std::function<void(unsigned int, const ElementStiffness &)> &visit) const;
 
+    /**
+     * Calls @p visit(t, K) as for_each_element_stiffness() does, for the tetrahedra
+     * listed in @p tets only (in that order; a tetrahedron listed twice is visited
+     * twice): what a local update of the stability bound needs after a cut. A model
+     * of springs only visits nothing.
+     */
+    virtual void
+    for_each_element_stiffness_of(
+      const ParticleSystem                                              &system,
+      const double                                                      *x,
+      const std::vector<unsigned int>                                   &tets,
+      const std::function<void(unsigned int, const ElementStiffness &)> &visit) const;
+
     /// Declares `subsection Force model` with the `Model` selector.
     static void
     declare_parameters(dealii::ParameterHandler &prm);

@@ -127,12 +127,12 @@ namespace lacerta::physics
     refresh_force_model();
 
     /**
-     * Tells the force model that the springs listed in @p changed (and the slots
+     * Tells the force model that the springs listed in @p changed_springs (and the slots
      * removed from the end of `springs`, and new particles) changed locally: a cut or
      * a tear (ForceModel::springs_changed()).
      */
     void
-    springs_changed(const std::vector<unsigned int> &changed);
+    springs_changed(const std::vector<unsigned int> &changed_springs);
 
     /**
      * Tells the force model that the masses of @p particles changed (and nothing else).
@@ -148,6 +148,27 @@ namespace lacerta::physics
     add_particle(const std::array<double, 3> &rest,
                  const std::array<double, 3> &x,
                  const std::array<double, 3> &v);
+
+    /**
+     * The particles whose springs, mass or existence changed locally since
+     * clear_changes(): the ends of the springs passed to springs_changed() (the
+     * particles whose tetrahedra changed are among them or their neighbours), those
+     * passed to masses_changed(), and those appended by add_particle(); with repeats.
+     * What the stability bound and the blow-up monitor update after a cut or a tear.
+     * reset() empties it: a new level of detail changes everything.
+     */
+    const std::vector<unsigned int> &
+    changed_particles() const
+    {
+      return changed;
+    }
+
+    /// Empties changed_particles() (whoever reacted to the changes calls it).
+    void
+    clear_changes()
+    {
+      changed.clear();
+    }
 
     /// Whether a force model was set (set_force_model()).
     bool
@@ -193,5 +214,7 @@ namespace lacerta::physics
     std::vector<double>         rest;
     std::unique_ptr<ForceModel> forces;
     unsigned int                force_threads = 1;
+    /// See changed_particles().
+    std::vector<unsigned int> changed;
   };
 } // namespace lacerta::physics

@@ -154,6 +154,19 @@ namespace lacerta::physics
       return parts[p];
     }
 
+    /**
+     * Calls @p visit(t, p, c) for every tetrahedron t of @p list with one of its
+     * copies, index c of range p (the copies of a tetrahedron are alike but for the
+     * vertices they own).
+     */
+    template <typename Visit>
+    void
+    for_each_copy_of(const std::vector<unsigned int> &list, const Visit &visit) const
+    {
+      for (const unsigned int t : list)
+        visit(t, copies[t][0].part, std::size_t(copies[t][0].index));
+    }
+
     /// The number of tetrahedra of every particle (the load to balance ranges by).
     static std::vector<std::size_t>
     tets_per_particle(const ParticleSystem &system);

@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,45 @@ namespace lacerta::physics
    */
   GershgorinTerms
   gershgorin_terms(const ParticleSystem &system, const double *positions);
+
+  /**
+   * The squares λ_i = ω_i² of particle_frequency_bounds() from the system's
+   * Gershgorin @p terms (0 for constrained or massless particles).
+   */
+  std::vector<double>
+  squared_frequency_bounds(const ParticleSystem &system, const GershgorinTerms &terms);
+
+  /**
+   * Working space of gershgorin_rows(), kept between calls so that a local update
+   * allocates nothing once it has grown: marks per particle, spring and tetrahedron,
+   * and the terms of the rows being computed.
+   */
+  struct GershgorinRowScratch
+  {
+    /// The call's mark; an array entry equal to it belongs to the current call.
+    unsigned int              stamp = 0;
+    std::vector<unsigned int> row_stamp, row_of, spring_stamp, spring_of, tet_stamp;
+    /// The tetrahedra around the rows and the springs at the rows.
+    std::vector<unsigned int>          tets, springs;
+    std::vector<std::array<double, 6>> blocks;
+    std::vector<double>                pair_norm, off_diagonal, stiffest;
+  };
+
+  /**
+   * The squared bounds λ_i = ω_i² of particle_frequency_bounds() and the stiffest
+   * spring at the particles @p rows only (distinct), from the springs and the force
+   * model's tetrahedra around them at positions @p x: into @p lambda and
+   * @p stiffest_spring, one entry per row. The same values as the computation over
+   * the whole system, to rounding, at a cost that depends on the rows' stars only.
+   * Needs `system.mesh` with local updates (its edges are the springs).
+   */
+  void
+  gershgorin_rows(const ParticleSystem            &system,
+                  const double                    *x,
+                  const std::vector<unsigned int> &rows,
+                  GershgorinRowScratch            &scratch,
+                  double                          *lambda,
+                  unsigned int                    *stiffest_spring);
 
   /**
    * Bounds the highest eigenvalue of M^-1/2 K M^-1/2 by block Gershgorin over the free
@@ -123,6 +163,21 @@ namespace lacerta::physics
             double                time,
             const std::string    &cause);
 
+    /**
+     * Continues watching after a local change of the system (a cut, a tear): checks
+     * now that the particles @p changed (ParticleSystem::changed_particles()) have
+     * finite states, the message naming @p cause, and leaves the rest of restart()
+     * to the next check(): it compares the energy with the ledger across the changes
+     * made since, names the first of them, and starts the ledger again. Costs
+     * O(changed particles + new particles), nothing global per cut.
+     */
+    void
+    note_local_change(const ParticleSystem            &system,
+                      const std::vector<unsigned int> &changed,
+                      unsigned int                     step,
+                      double                           time,
+                      const std::string               &cause);
+
     /// Work done on the system by prescribed motions and external forces so far (J).
     double
     input_work() const
@@ -136,13 +191,14 @@ namespace lacerta::physics
     void
     compute_load_forces(const ParticleSystem &system);
 
-    /// Throws if a position or velocity is not finite; @p after names a change or is
-    /// empty.
+    /// Throws if a position or velocity of the @p particles (all if nullptr) is not
+    /// finite; @p after names a change or is empty.
     void
-    check_finite(const ParticleSystem &system,
-                 unsigned int          step,
-                 double                time,
-                 const std::string    &after) const;
+    check_finite(const ParticleSystem            &system,
+                 const std::vector<unsigned int> *particles,
+                 unsigned int                     step,
+                 double                           time,
+                 const std::string               &after) const;
 
     /// Throws if the energy exceeds the ledger by more than the tolerance; returns the
     /// state's energy scale (kinetic + elastic + |body force potential|).
@@ -155,6 +211,9 @@ namespace lacerta::physics
     /// Starts the energy ledger (initial energy, work, loads) from the current state.
     void
     start_ledger(const ParticleSystem &system);
+
+    /// What the first local change since the last check was, and when ("" if none).
+    std::string pending_change;
 
     double              tolerance;
     double              initial_energy;

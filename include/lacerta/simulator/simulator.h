@@ -29,8 +29,10 @@ namespace lacerta::scene
 namespace lacerta::physics
 {
   class BlowUpMonitor;
+  struct FrequencyBound;
   class Integrator;
   class MassBalancer;
+  class StabilityBound;
 } // namespace lacerta::physics
 
 namespace lacerta
@@ -145,7 +147,10 @@ namespace lacerta
     /**
      * The simulator's subscriber to Scene::system_changed: the mass redistribution,
      * the invariants (after a local change), the integrator's scratch space, the
-     * blow-up monitor's ledger and the sub-steps start afresh on the changed system.
+     * blow-up monitor's ledger and the stability bound follow the changed system, and
+     * the sub-steps are chosen again. After a local change (a cut, a tear) the monitor
+     * and the bound are updated around the changed particles only; their wall time is
+     * added to the step's cut or tear time.
      */
     void
     on_system_changed(const scene::SystemChange &change);
@@ -159,12 +164,12 @@ namespace lacerta
     evaluate_energies();
 
     /**
-     * Checks the time step against the stability limit of the current state; returns
-     * the sub-step count. @p current sub-steps, if given and still below the limit,
-     * are kept without a report.
+     * Checks the time step against the stability limit @p bound of the current state;
+     * returns the sub-step count. @p current sub-steps, if given and still below the
+     * limit, are kept without a report.
      */
     unsigned int
-    choose_substeps(unsigned int current = 0);
+    choose_substeps(const physics::FrequencyBound &bound, unsigned int current = 0);
 
     /**
      * With multiresolution: prints the critical time step of the level of detail next
@@ -207,9 +212,13 @@ namespace lacerta
       unsigned int last_unresolved = 0, n_balances = 0;
     } redistribution;
     std::unique_ptr<physics::BlowUpMonitor> monitor;
-    std::unique_ptr<dealii::TimerOutput>    timer;
-    std::chrono::steady_clock::time_point   run_start;
-    double                                  last_progress = 0;
-    bool                                    show_progress = false;
+    /// The stability bound per particle, updated locally after cuts and tears.
+    std::unique_ptr<physics::StabilityBound> stability_bound;
+    /// Wall time of on_system_changed() since the last cut or tear read it (s).
+    double                                change_seconds = 0;
+    std::unique_ptr<dealii::TimerOutput>  timer;
+    std::chrono::steady_clock::time_point run_start;
+    double                                last_progress = 0;
+    bool                                  show_progress = false;
   };
 } // namespace lacerta

@@ -1,0 +1,84 @@
+/**
+ * @file
+ * The stability bound kept per particle and updated where the system changed.
+ */
+#pragma once
+
+#include <lacerta/physics/stability.h>
+
+#include <vector>
+
+namespace lacerta::physics
+{
+  class ParticleSystem;
+
+  /**
+   * The block Gershgorin bound of bound_highest_frequency(), kept per particle so that
+   * a local change of the system (a cut, a tear) costs a bound over the changed
+   * particles' stars, not over the whole system: nothing global per cut.
+   *
+   * Between two compute(), a particle's bound is that of the positions it was last
+   * computed at, as the bound of bound_highest_frequency() is that of the positions
+   * it was called at.
+   */
+  class StabilityBound
+  {
+  public:
+    /// Computes the bound at every particle, at the current positions.
+    void
+    compute(const ParticleSystem &system);
+
+    /**
+     * Updates the bound after a local change of the system: the particles listed in
+     * @p changed (ParticleSystem::changed_particles(), repeats allowed) and their
+     * neighbours are bounded again at the current positions, the others keep their
+     * bound; appended particles join. Computes everything if the system has no mesh
+     * with local updates, or if compute() was never called.
+     */
+    void
+    update(const ParticleSystem &system, const std::vector<unsigned int> &changed);
+
+    /// The highest bound over the particles, and where it is (the first particle
+    /// among equals).
+    FrequencyBound
+    bound() const;
+
+    /// The squared bound λ_i = ω_i² kept for particle @p i (rad²/s²).
+    double
+    squared_frequency(const unsigned int i) const
+    {
+      return lambda[i];
+    }
+
+  private:
+    /// Builds the tree of maxima over `lambda`, with room for at least @p n
+    /// particles.
+    void
+    build_tree(unsigned int n);
+
+    /// Sets particle @p i's bound and updates the tree of maxima above it.
+    void
+    set(unsigned int i, double squared_omega, unsigned int spring);
+
+    /// Whether particle @p a's bound beats @p b's (higher, or equal and first).
+    bool
+    beats(unsigned int a, unsigned int b) const;
+
+    /// λ_i = ω_i² and the stiffest spring of every particle.
+    std::vector<double>       lambda;
+    std::vector<unsigned int> stiffest;
+    /// A tree of maxima: node k holds the best particle of its two children, the
+    /// leaves (from `leaves` on) the particles; `none` past the last particle.
+    std::vector<unsigned int>     tree;
+    unsigned int                  leaves = 0;
+    static constexpr unsigned int none   = static_cast<unsigned int>(-1);
+
+    /// The changed particles of an update, once each, and its rows (they and their
+    /// neighbours), marked in `row_mark`.
+    std::vector<unsigned int> seeds, rows, row_mark;
+    unsigned int              mark = 0;
+    std::vector<double>       row_lambda;
+    std::vector<unsigned int> row_spring;
+    GershgorinRowScratch      scratch;
+  };
+} // namespace lacerta::physics

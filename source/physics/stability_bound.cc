@@ -1,0 +1,130 @@
+#include <lacerta/mesh/tet_mesh.h>
+#include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/stability_bound.h>
+
+#include <cmath>
+
+namespace lacerta::physics
+{
+  void
+  StabilityBound::compute(const ParticleSystem &system)
+  {
+    const GershgorinTerms terms = gershgorin_terms(system, system.position.data());
+    lambda                      = squared_frequency_bounds(system, terms);
+    stiffest                    = terms.stiffest_spring;
+    build_tree(system.n_particles());
+  }
+
+
+  void
+  StabilityBound::update(const ParticleSystem            &system,
+                         const std::vector<unsigned int> &changed)
+  {
+    if (system.mesh == nullptr || !system.mesh->has_local_updates() || leaves == 0)
+    {
+      compute(system);
+      return;
+    }
+    const unsigned int n = system.n_particles();
+    lambda.resize(n, 0.0);
+    stiffest.resize(n, 0);
+    if (n > leaves)
+      build_tree(n);
+    // A particle's bound depends on its springs and tetrahedra and on its neighbours'
+    // masses: the changed particles (each once: `changed` repeats them) and every
+    // vertex of their stars are bounded again. Marks below `seed` are old, `seed`
+    // marks a changed particle, `seed + 1` a row.
+    const unsigned int seed = mark + 1;
+    mark += 2;
+    row_mark.resize(n, 0);
+    seeds.clear();
+    for (const unsigned int p : changed)
+      if (row_mark[p] < seed)
+      {
+        row_mark[p] = seed;
+        seeds.push_back(p);
+      }
+    rows.clear();
+    for (const unsigned int p : seeds)
+      for (const unsigned int t : system.mesh->tets_of_vertex(p))
+        for (const unsigned int v : system.mesh->tet(t))
+          if (row_mark[v] != mark)
+          {
+            row_mark[v] = mark;
+            rows.push_back(v);
+          }
+    for (const unsigned int p : seeds)
+      if (row_mark[p] != mark)
+      {
+        row_mark[p] = mark;
+        rows.push_back(p);
+      }
+    row_lambda.resize(rows.size());
+    row_spring.resize(rows.size());
+    gershgorin_rows(system,
+                    system.position.data(),
+                    rows,
+                    scratch,
+                    row_lambda.data(),
+                    row_spring.data());
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      set(rows[r], row_lambda[r], row_spring[r]);
+  }
+
+
+  FrequencyBound
+  StabilityBound::bound() const
+  {
+    FrequencyBound result;
+    if (leaves == 0 || tree[1] == none)
+      return result;
+    const double highest = lambda[tree[1]];
+    if (!(highest > 0) && !std::isnan(highest))
+      return result;
+    result.particle = tree[1];
+    result.spring   = stiffest[tree[1]];
+    result.omega    = std::sqrt(highest);
+    return result;
+  }
+
+
+  void
+  StabilityBound::build_tree(const unsigned int n)
+  {
+    leaves = 1;
+    while (leaves < n)
+      leaves *= 2;
+    tree.assign(2 * std::size_t(leaves), none);
+    for (unsigned int i = 0; i < n; ++i)
+      tree[leaves + i] = i;
+    for (unsigned int k = leaves - 1; k >= 1; --k)
+      tree[k] = beats(tree[2 * k + 1], tree[2 * k]) ? tree[2 * k + 1] : tree[2 * k];
+  }
+
+
+  void
+  StabilityBound::set(const unsigned int i,
+                      const double       squared_omega,
+                      const unsigned int spring)
+  {
+    lambda[i]        = squared_omega;
+    stiffest[i]      = spring;
+    tree[leaves + i] = i;
+    for (unsigned int k = (leaves + i) / 2; k >= 1; k /= 2)
+      tree[k] = beats(tree[2 * k + 1], tree[2 * k]) ? tree[2 * k + 1] : tree[2 * k];
+  }
+
+
+  bool
+  StabilityBound::beats(const unsigned int a, const unsigned int b) const
+  {
+    if (a == none)
+      return false;
+    if (b == none)
+      return true;
+    // A bound that is not a number wins: the caller reports it.
+    if (std::isnan(lambda[a]) || std::isnan(lambda[b]))
+      return std::isnan(lambda[a]) && (!std::isnan(lambda[b]) || a < b);
+    return lambda[a] > lambda[b] || (lambda[a] == lambda[b] && a < b);
+  }
+} // namespace lacerta::physics

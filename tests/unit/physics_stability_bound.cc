@@ -1,0 +1,137 @@
+// The stability bound kept per particle (physics/stability_bound.h): after cuts, its
+// local updates give what the bound over the whole system gives, for every force
+// model; and the blow-up monitor follows local changes without a global restart.
+#include <lacerta/cut/tool.h>
+#include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/stability.h>
+#include <lacerta/physics/stability_bound.h>
+#include <lacerta/scene/scene.h>
+
+#include <gtest/gtest.h>
+
+#include "mt_test_support.h"
+#include <cmath>
+#include <limits>
+#include <random>
+#include <sstream>
+
+namespace lacerta
+{
+  using test_support::slab_cut_scene;
+
+
+  TEST(StabilityBound, LocalUpdatesAfterCutsEqualTheBoundOfTheWholeSystem)
+  {
+    // Random straight strokes across the slab, on a tissue moved off its rest shape
+    // (the geometric stiffness counts): after every blade motion the bound updated
+    // around the changed particles equals, at every particle, the one computed over
+    // the whole system.
+    std::mt19937                           random(7);
+    std::uniform_real_distribution<double> across(-0.045, 0.045);
+    unsigned int                           n_compared = 0;
+    for (const std::string model : {"linear springs", "volume springs", "corotated fem"})
+      for (unsigned int stroke = 0; stroke < 3; ++stroke)
+      {
+        const double             x0 = across(random), x1 = across(random);
+        auto                     scene  = slab_cut_scene(model, x0, 0.07, x1, -0.07);
+        physics::ParticleSystem &system = *scene->system;
+        std::uniform_real_distribution<double> jitter(-5e-4, 5e-4);
+        for (double &x : system.position)
+          x += jitter(random);
+        physics::StabilityBound bound;
+        bound.compute(system);
+        system.clear_changes();
+        const unsigned int before = system.n_particles();
+        for (unsigned int k = 1; k <= 16; ++k)
+        {
+          scene->cut(scene->tool->blade(k / 16.0), 0.01 * k);
+          bound.update(system, system.changed_particles());
+          system.clear_changes();
+          const std::vector<double> whole = physics::squared_frequency_bounds(
+            system, physics::gershgorin_terms(system, system.position.data()));
+          double highest = 0;
+          for (unsigned int i = 0; i < system.n_particles(); ++i)
+          {
+            highest = std::max(highest, whole[i]);
+            EXPECT_NEAR(bound.squared_frequency(i), whole[i], 1e-11 * whole[i])
+              << model << ", stroke " << stroke << ", motion " << k << ", particle " << i;
+          }
+          const physics::FrequencyBound global = physics::bound_highest_frequency(system);
+          EXPECT_NEAR(bound.bound().omega, std::sqrt(highest), 1e-11 * global.omega);
+          EXPECT_NEAR(bound.bound().omega, global.omega, 1e-11 * global.omega);
+          ++n_compared;
+        }
+        EXPECT_GT(system.n_particles(), before) << model << ": the strokes cut nothing";
+      }
+    EXPECT_EQ(n_compared, 3u * 3u * 16u);
+  }
+
+
+  TEST(StabilityBound, KeepsTheHighestParticleAsItsRowsChange)
+  {
+    // Without a mesh the bound is computed anew at every update; the tree of maxima
+    // then names the particle bound_highest_frequency() names.
+    auto scene  = slab_cut_scene("linear springs", 0.003, 0.07, 0.003, -0.07);
+    auto system = scene->system.get();
+    physics::StabilityBound bound;
+    bound.compute(*system);
+    const physics::FrequencyBound global = physics::bound_highest_frequency(*system);
+    EXPECT_EQ(bound.bound().particle, global.particle);
+    EXPECT_EQ(bound.bound().spring, global.spring);
+    EXPECT_DOUBLE_EQ(bound.bound().omega, global.omega);
+    // A particle made light becomes the highest; its neighbours are updated too.
+    const unsigned int light = system->n_particles() / 2;
+    system->mass[light] *= 1e-3;
+    bound.update(*system, {light});
+    EXPECT_EQ(bound.bound().particle, physics::bound_highest_frequency(*system).particle);
+    EXPECT_EQ(bound.bound().particle, light);
+    // A NaN mass wins and is reported, not hidden.
+    system->mass[3] = std::numeric_limits<double>::quiet_NaN();
+    bound.update(*system, {3});
+    EXPECT_TRUE(std::isnan(bound.bound().omega));
+  }
+
+
+  TEST(StabilityBound, MonitorFollowsLocalChangesAndRestartsAtItsNextCheck)
+  {
+    auto scene  = slab_cut_scene("linear springs", 0.003, 0.07, 0.003, -0.07);
+    auto system = scene->system.get();
+    physics::BlowUpMonitor monitor(*system, 1.0);
+    // A cut adds particles: the monitor takes them without a global restart, and its
+    // next check accepts the state and starts the ledger again.
+    for (unsigned int k = 1; k <= 8; ++k)
+      scene->cut(scene->tool->blade(k / 16.0), 0.01 * k);
+    ASSERT_FALSE(system->changed_particles().empty());
+    EXPECT_NO_THROW(monitor.note_local_change(
+      *system, system->changed_particles(), 8, 0.08, "the cut"));
+    system->clear_changes();
+    EXPECT_NO_THROW(monitor.check(*system, 9, 0.09));
+    // Energy a change adds is caught at the next check, which names the change.
+    for (double &v : system->velocity)
+      v = 1.0;
+    monitor.note_local_change(*system, {0, 1}, 10, 0.1, "the tear");
+    try
+    {
+      monitor.check(*system, 12, 0.12);
+      ADD_FAILURE() << "the energy added by the change was not caught";
+    }
+    catch (const Error &e)
+    {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("since the tear at step 10"), std::string::npos) << message;
+    }
+    // A non-finite state at a changed particle is caught at once.
+    system->position[3 * 5 + 1] = std::numeric_limits<double>::infinity();
+    try
+    {
+      monitor.note_local_change(*system, {4, 5}, 13, 0.13, "the cut");
+      ADD_FAILURE() << "an infinite position was not caught";
+    }
+    catch (const Error &e)
+    {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("right after the cut"), std::string::npos) << message;
+      EXPECT_NE(message.find("not a finite number"), std::string::npos) << message;
+    }
+  }
+} // namespace lacerta
