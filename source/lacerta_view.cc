@@ -4,7 +4,6 @@
 #include <lacerta/view/viewer.h>
 
 #include <deal.II/base/exceptions.h>
-#include <deal.II/base/mpi.h>
 
 #include <cstdio>
 #include <iostream>
@@ -34,7 +33,8 @@ namespace
 int
 main(int argc, char **argv)
 {
-  dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv);
+  // No MPI: the viewer runs simulations without postprocessors (Viewer), so nothing
+  // of it uses MPI (Simulator::needs_mpi()).
   dealii::deal_II_exceptions::disable_abort_on_exception();
   dealii::deal_II_exceptions::suppress_stacktrace_in_exceptions();
 

@@ -8,11 +8,11 @@
 #include <deal.II/base/mpi.h>
 
 #include <iostream>
+#include <optional>
 
 int
 main(int argc, char **argv)
 {
-  dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv);
   dealii::deal_II_exceptions::disable_abort_on_exception();
   dealii::deal_II_exceptions::suppress_stacktrace_in_exceptions();
 
@@ -33,6 +33,12 @@ main(int argc, char **argv)
     {
       dealii::ParameterHandler prm;
       lacerta::Simulator::read_parameters(argv[1], prm);
+      // MPI only where it is used: its runtime's start can fail on a busy machine
+      // ("Local abort before MPI_INIT completed"), and a scene of springs alone must
+      // not depend on it.
+      std::optional<dealii::Utilities::MPI::MPI_InitFinalize> mpi;
+      if (lacerta::Simulator::needs_mpi(prm))
+        mpi.emplace(argc, argv);
       if (prm.get("Mode") == "study")
         lacerta::fem::Study(prm).run();
       else

@@ -259,6 +259,17 @@ namespace lacerta
   }
 
 
+  bool
+  Simulator::needs_mpi(const dealii::ParameterHandler &prm)
+  {
+    if (prm.get("Mode") == "study")
+      return true;
+    const std::vector<std::string> names = dealii::Utilities::split_string_list(
+      prm.get({"Postprocess"}, "List of postprocessors"));
+    return std::find(names.begin(), names.end(), "fem comparison") != names.end();
+  }
+
+
   void
   Simulator::print_help(std::ostream &out)
   {

@@ -77,6 +77,15 @@ namespace lacerta
     read_parameters(const std::string &file, dealii::ParameterHandler &prm);
 
     /**
+     * Whether the run @p prm describes uses MPI: a study (`Mode = study`) or the FEM
+     * reference (the `fem comparison` postprocessor), whose solvers are Trilinos'.
+     * The programs initialise MPI only then: a scene of springs alone does not depend
+     * on the MPI runtime starting.
+     */
+    static bool
+    needs_mpi(const dealii::ParameterHandler &prm);
+
+    /**
      * Prints the full documented default parameter file, with every plugin of every
      * kind and its description, to @p out.
      */
