@@ -481,13 +481,7 @@ namespace lacerta::cut
           join_affected(n);
       }
     std::sort(front_edge_ids.begin(), front_edge_ids.end());
-    if (!analyse(surface))
-    {
-      ++statistics.postponed;
-      lap(statistics.analysis_seconds);
-      spent();
-      return;
-    }
+    analyse(surface);
     // One TetCut per affected tetrahedron; split them all before changing anything.
     removed.clear();
     cuts.clear();
@@ -747,11 +741,16 @@ namespace lacerta::cut
   }
 
 
-  bool
+  void
   Cutter::analyse(const SweepSurface &surface)
   {
     const double eps = parameters.snap_fraction;
-    for (unsigned int iteration = 0; iteration < 8; ++iteration)
+    // The closure is a fixed point: each pass adds the cells that must be split with
+    // the set (around reached crossings, the stars of vertices joining the crack, the
+    // neighbours across front faces), at least one per pass, so it ends within the
+    // cells next to the swept surface. The number of passes grows with the cells
+    // along the front; any fixed cap postpones every sweep of a fine enough mesh.
+    while (true)
     {
       ++analysis_stamp;
       verts.clear();
@@ -988,11 +987,10 @@ namespace lacerta::cut
               missing.push_back(n);
           }
       if (missing.empty())
-        return true;
+        return;
       for (const unsigned int n : missing)
         join_affected(n);
     }
-    return false;
   }
 
 

@@ -370,7 +370,9 @@ TEST(CutBoundaryFaceTree, SweptTriangleQueriesKeepEveryFaceTheyMeet)
       const auto triangle = BoundaryFaceTree::triangle(f, x.data());
       if (cut::triangles_intersect(triangle, swept[0])
           || cut::triangles_intersect(triangle, swept[1]))
+      {
         EXPECT_TRUE(in_slim.count({bf.tet, bf.face})) << "query " << q;
+      }
     }
     ASSERT_FALSE(::testing::Test::HasFailure());
   }

@@ -280,8 +280,8 @@ namespace lacerta::cut
     vertex_data(unsigned int v, const SweepSurface &surface);
 
     /// Sides, cut edges and front points on `affected`, closed under what must be
-    /// split alike; false if the closure did not converge (the sweep is postponed).
-    bool
+    /// split alike.
+    void
     analyse(const SweepSurface &surface);
 
     /// The front point of face @p f of tetrahedron @p t, into @p fs.
