@@ -44,6 +44,8 @@ namespace lacerta::physics
     body_acceleration = {{0, 0, 0}};
     rest              = rest_positions;
     changed.clear();
+    listed.assign(n_particles(), 0);
+    all_changed = true;
   }
 
 
@@ -78,8 +80,8 @@ namespace lacerta::physics
   {
     for (const unsigned int s : changed_springs)
     {
-      changed.push_back(springs.a[s]);
-      changed.push_back(springs.b[s]);
+      note_changed(springs.a[s]);
+      note_changed(springs.b[s]);
     }
     forces->springs_changed(*this, changed_springs);
   }
@@ -88,7 +90,8 @@ namespace lacerta::physics
   void
   ParticleSystem::masses_changed(const std::vector<unsigned int> &particles)
   {
-    changed.insert(changed.end(), particles.begin(), particles.end());
+    for (const unsigned int i : particles)
+      note_changed(i);
     forces->masses_changed(*this, particles);
   }
 
@@ -108,8 +111,33 @@ namespace lacerta::physics
     mass.push_back(0.0);
     mass_shift.push_back(0.0);
     free.push_back(1.0);
-    changed.push_back(n_particles() - 1);
+    note_changed(n_particles() - 1);
     return n_particles() - 1;
+  }
+
+
+  void
+  ParticleSystem::note_changed(const unsigned int i)
+  {
+    if (all_changed)
+      return;
+    if (listed.size() <= i)
+      listed.resize(n_particles(), 0);
+    if (listed[i] == 0)
+    {
+      listed[i] = 1;
+      changed.push_back(i);
+    }
+  }
+
+
+  void
+  ParticleSystem::clear_changes()
+  {
+    for (const unsigned int i : changed)
+      listed[i] = 0;
+    changed.clear();
+    all_changed = false;
   }
 
 

@@ -20,7 +20,8 @@ namespace lacerta::physics
   StabilityBound::update(const ParticleSystem            &system,
                          const std::vector<unsigned int> &changed)
   {
-    if (system.mesh == nullptr || !system.mesh->has_local_updates() || leaves == 0)
+    if (system.mesh == nullptr || !system.mesh->has_local_updates() || leaves == 0
+        || system.all_particles_changed())
     {
       compute(system);
       return;

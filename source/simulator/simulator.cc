@@ -591,11 +591,11 @@ namespace lacerta
     if (change.cause != scene::SystemChange::Cause::level_of_detail)
       check(step);
     integrator->initialize(system);
-    if (change.reassembled())
+    if (change.reassembled() || system.all_particles_changed())
     {
-      // Every particle is new: the blow-up monitor checks the new state against its
-      // ledger at once, so that a change that puts particles far off stops the run
-      // naming it, then restarts; the bound is computed anew.
+      // Every particle is new (or counts as changed): the blow-up monitor checks the new
+      // state against its ledger at once, so that a change that puts particles far off
+      // stops the run naming it, then restarts; the bound is computed anew.
       monitor->restart(system, step, change.time, change.describe());
       stability_bound->compute(system);
     }

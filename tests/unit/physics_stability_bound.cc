@@ -97,10 +97,13 @@ namespace lacerta
     auto scene  = slab_cut_scene("linear springs", 0.003, 0.07, 0.003, -0.07);
     auto system = scene->system.get();
     physics::BlowUpMonitor monitor(*system, 1.0);
+    system->clear_changes();
     // A cut adds particles: the monitor takes them without a global restart, and its
     // next check accepts the state and starts the ledger again.
+    const unsigned int before = system->n_particles();
     for (unsigned int k = 1; k <= 8; ++k)
       scene->cut(scene->tool->blade(k / 16.0), 0.01 * k);
+    ASSERT_GT(system->n_particles(), before);
     ASSERT_FALSE(system->changed_particles().empty());
     EXPECT_NO_THROW(monitor.note_local_change(
       *system, system->changed_particles(), 8, 0.08, "the cut"));
@@ -133,5 +136,38 @@ namespace lacerta
       EXPECT_NE(message.find("right after the cut"), std::string::npos) << message;
       EXPECT_NE(message.find("not a finite number"), std::string::npos) << message;
     }
+  }
+} // namespace lacerta
+
+
+namespace lacerta
+{
+  TEST(StabilityBound, ChangesAreListedOnceAndAResetChangesEverything)
+  {
+    // However often a particle is reported, it is listed once, so the list never
+    // outgrows the particles; after a reset every particle counts as changed, which
+    // the bound answers with a full computation.
+    auto scene =
+      test_support::slab_cut_scene("linear springs", 0.003, 0.07, 0.003, -0.07);
+    physics::ParticleSystem  &system = *scene->system;
+    std::vector<unsigned int> all(system.n_particles());
+    for (unsigned int i = 0; i < all.size(); ++i)
+      all[i] = i;
+    system.clear_changes();
+    for (unsigned int k = 0; k < 5; ++k)
+      system.masses_changed(all);
+    EXPECT_EQ(system.changed_particles(), all);
+    system.clear_changes();
+    system.masses_changed({9, 4, 9});
+    EXPECT_EQ(system.changed_particles(), (std::vector<unsigned int>{9, 4}));
+
+    physics::StabilityBound bound;
+    bound.compute(system);
+    const std::vector<double> rest = system.rest_position();
+    system.reset(rest);
+    EXPECT_TRUE(system.all_particles_changed());
+    EXPECT_TRUE(system.changed_particles().empty());
+    system.clear_changes();
+    EXPECT_FALSE(system.all_particles_changed());
   }
 } // namespace lacerta

@@ -151,11 +151,11 @@ namespace lacerta::physics
 
     /**
      * The particles whose springs, mass or existence changed locally since
-     * clear_changes(): the ends of the springs passed to springs_changed() (the
-     * particles whose tetrahedra changed are among them or their neighbours), those
-     * passed to masses_changed(), and those appended by add_particle(); with repeats.
-     * What the stability bound and the blow-up monitor update after a cut or a tear.
-     * reset() empties it: a new level of detail changes everything.
+     * clear_changes(), each once, in the order first reported: the ends of the springs
+     * passed to springs_changed() (the particles whose tetrahedra changed are among
+     * them or their neighbours), those passed to masses_changed(), and those appended
+     * by add_particle(). What the stability bound and the blow-up monitor update after
+     * a cut or a tear. Empty when all_particles_changed().
      */
     const std::vector<unsigned int> &
     changed_particles() const
@@ -163,12 +163,18 @@ namespace lacerta::physics
       return changed;
     }
 
-    /// Empties changed_particles() (whoever reacted to the changes calls it).
-    void
-    clear_changes()
+    /// Whether every particle counts as changed since clear_changes(): after reset()
+    /// (a new level of detail).
+    bool
+    all_particles_changed() const
     {
-      changed.clear();
+      return all_changed;
     }
+
+    /// Empties changed_particles() and ends all_particles_changed() (whoever reacted
+    /// to the changes calls it).
+    void
+    clear_changes();
 
     /// Whether a force model was set (set_force_model()).
     bool
@@ -214,7 +220,14 @@ namespace lacerta::physics
     std::vector<double>         rest;
     std::unique_ptr<ForceModel> forces;
     unsigned int                force_threads = 1;
-    /// See changed_particles().
-    std::vector<unsigned int> changed;
+    /// See changed_particles() and all_particles_changed(); `listed` marks the
+    /// particles in `changed`.
+    std::vector<unsigned int>  changed;
+    std::vector<unsigned char> listed;
+    bool                       all_changed = false;
+
+    /// Lists particle @p i in changed_particles(), unless all count as changed.
+    void
+    note_changed(unsigned int i);
   };
 } // namespace lacerta::physics
