@@ -6,6 +6,8 @@
 #include <lacerta/physics/force_model.h>
 #include <lacerta/physics/integrator.h>
 #include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/stability.h>
+#include <lacerta/physics/stability_bound.h>
 
 #include <deal.II/base/function.h>
 #include <deal.II/grid/grid_generator.h>
@@ -29,6 +31,10 @@ namespace lacerta::bench
     {
       unsigned int mesh_size = 0, steps = 0;
       double       cut = 0, created = 0, update_ms = 0, reinit_ms = 0, relax_ms = 0;
+      /// The simulator's response to the cut (the stability bound and the blow-up
+      /// monitor follow the changed particles), and the whole cut step: search, UpdT,
+      /// ReinitT and the response.
+      double response_ms = 0, whole_ms = 0;
       /// The phases of CutStepStatistics: search (not in UpdT), then the parts of
       /// UpdT: analysis, split, children, mesh, physics.
       std::array<double, 6> phase_ms{};
@@ -74,9 +80,11 @@ namespace lacerta::bench
       const auto               particles = make_particle_system(mesh, density, youngs);
       physics::ParticleSystem &system    = *particles;
       double                   integral  = physics::integrate_over_mesh(mesh, density);
+      // The mesh as the scene sets it (the stability bound's local update walks its
+      // stars).
+      system.mesh = &mesh;
       if (model != "linear springs")
       {
-        system.mesh           = &mesh;
         system.youngs_modulus = &youngs;
         system.poisson_ratio  = 0.45;
         system.set_force_model(physics::ForceModelRegistry::create(model), 1);
@@ -91,14 +99,28 @@ namespace lacerta::bench
       parameters.max_advance = 100; // one sweep per step: CuT grows with the step
       cut::Cutter cutter(
         mesh, system, density, youngs, integral, parameters, blade(0.06));
-      Row                 row;
-      const double        end = partial ? 0.0 : -0.06;
+      // What the Simulator does after every cut step (Simulator::on_system_changed()).
+      physics::StabilityBound bound;
+      bound.compute(system);
+      system.clear_changes();
+      physics::BlowUpMonitor monitor(system, 1.0);
+      Row                    row;
+      const double           end = partial ? 0.0 : -0.06;
       std::vector<double> flush_buffer(between == Between::flush ? (64u << 20) / 8 : 0);
       for (unsigned int k = 1; k <= n_steps; ++k)
       {
         const auto s = cutter.move_blade(blade(0.06 + (end - 0.06) * k / n_steps));
         if (s.cut_tets == 0)
           continue;
+        const auto r0 = Clock::now();
+        monitor.note_local_change(system, system.changed_particles(), k, 0.0, "the cut");
+        bound.update(system, system.changed_particles());
+        system.clear_changes();
+        const double response =
+          1e3 * std::chrono::duration<double>(Clock::now() - r0).count();
+        row.response_ms += response;
+        row.whole_ms +=
+          1e3 * (s.search_seconds + s.update_seconds + s.reinit_seconds) + response;
         const auto t0 = Clock::now();
         if (between == Between::relax)
         {
@@ -131,6 +153,8 @@ namespace lacerta::bench
         row.update_ms /= row.steps;
         row.reinit_ms /= row.steps;
         row.relax_ms /= row.steps;
+        row.response_ms /= row.steps;
+        row.whole_ms /= row.steps;
         for (double &t : row.phase_ms)
           t /= row.steps;
       }
@@ -158,14 +182,30 @@ namespace lacerta::bench
 
 
     void
+    print_header()
+    {
+      std::printf("%8s %8s %8s %10s %10s %10s %10s %10s\n",
+                  "MS",
+                  "CuT",
+                  "CrT",
+                  "UpdT",
+                  "ReinitT",
+                  "RespT",
+                  "CutStep",
+                  "RxT");
+    }
+
+    void
     print(const Row &r)
     {
-      std::printf("%8u %8.1f %8.1f %10.3f %10.3f %10.3f\n",
+      std::printf("%8u %8.1f %8.1f %10.3f %10.3f %10.3f %10.3f %10.3f\n",
                   r.mesh_size,
                   r.cut,
                   r.created,
                   r.update_ms,
                   r.reinit_ms,
+                  r.response_ms,
+                  r.whole_ms,
                   r.relax_ms);
     }
 
@@ -241,8 +281,7 @@ namespace lacerta::bench
           return 1;
         }
         const Row r = best_of_three(n, steps, partial, between, model);
-        std::printf(
-          "%8s %8s %8s %10s %10s %10s\n", "MS", "CuT", "CrT", "UpdT", "ReinitT", "RxT");
+        print_header();
         print(r);
         print_phase_header();
         print_phases(r);
@@ -256,17 +295,17 @@ namespace lacerta::bench
         return 1;
       }
       std::printf("Table 1 (averages over the steps that cut, the run with the least "
-                  "UpdT of three; times in ms):\n");
-      std::printf(
-        "%8s %8s %8s %10s %10s %10s\n", "MS", "CuT", "CrT", "UpdT", "ReinitT", "RxT");
+                  "UpdT of three; times in ms; RespT: the stability bound and the "
+                  "blow-up monitor after the cut; CutStep: search + UpdT + ReinitT + "
+                  "RespT, the whole cut step):\n");
+      print_header();
       // Slow and fast strokes on the paper's three sizes (2x2, 6x6, 20x20 x 3 hexahedra).
       for (const auto &[n, steps] : std::vector<std::pair<unsigned, unsigned>>{
              {2, 40}, {2, 2}, {6, 60}, {6, 3}, {20, 120}, {20, 4}})
         print(best_of_three(n, steps, true));
       std::printf("\nUpdate time against tetrahedra cut per step (complete cut, 6000 and "
                   "60000 tetrahedra):\n");
-      std::printf(
-        "%8s %8s %8s %10s %10s %10s\n", "MS", "CuT", "CrT", "UpdT", "ReinitT", "RxT");
+      print_header();
       std::vector<Row> rows;
       for (const unsigned int n : {20u, 63u})
         for (const unsigned int steps : {64u, 32u, 16u, 8u})
