@@ -20,8 +20,10 @@ namespace lacerta::physics
   StabilityBound::update(const ParticleSystem            &system,
                          const std::vector<unsigned int> &changed)
   {
+    // The local rows walk the mesh's stars, whose edges are the springs.
     if (system.mesh == nullptr || !system.mesh->has_local_updates() || leaves == 0
-        || system.all_particles_changed())
+        || system.all_particles_changed()
+        || system.mesh->n_edges() != system.springs.size())
     {
       compute(system);
       return;

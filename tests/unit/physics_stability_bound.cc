@@ -45,6 +45,10 @@ namespace lacerta
         for (unsigned int k = 1; k <= 16; ++k)
         {
           scene->cut(scene->tool->blade(k / 16.0), 0.01 * k);
+          // The springs are the mesh's edges, so the update is local (not the full
+          // computation it falls back to otherwise).
+          ASSERT_EQ(scene->mesh.n_edges(), system.springs.size());
+          ASSERT_FALSE(system.all_particles_changed());
           bound.update(system, system.changed_particles());
           system.clear_changes();
           const std::vector<double> whole = physics::squared_frequency_bounds(

@@ -33,7 +33,8 @@ namespace lacerta::physics
      * @p changed (ParticleSystem::changed_particles(), repeats allowed) and their
      * neighbours are bounded again at the current positions, the others keep their
      * bound; appended particles join. Computes everything if the system has no mesh
-     * with local updates, if every particle counts as changed
+     * with local updates whose edges are its springs, if every particle counts as
+     * changed
      * (ParticleSystem::all_particles_changed()), or if compute() was never called.
      */
     void
