@@ -161,25 +161,21 @@ namespace lacerta::physics
       elastic_energy(const ParticleSystem &, const double *x) const override
       {
         double energy = 0;
-        for (unsigned int p = 0; p < ranges.n_parts(); ++p)
-        {
-          const PartitionedTets::Part &part = tets.part(p);
-          for (std::size_t c = 0; c < part.size(); ++c)
-            // Each tetrahedron once: in the range that owns its local vertex 0.
-            if (part.owned[c] & 1u)
-            {
-              const Matrix3 F       = tets.part(p).deformation_gradient(c, x);
-              const Matrix3 R       = rotation_of(F);
-              double        stretch = 0, trace = -3;
-              for (unsigned int k = 0; k < 9; ++k)
-                stretch += (F[k] - R[k]) * (F[k] - R[k]);
-              for (unsigned int k = 0; k < 9; ++k)
-                trace += R[k] * F[k];
-              energy +=
-                part.rest_volume[c] * part.youngs_modulus[c]
-                * (mu_per_modulus * stretch + 0.5 * lambda_per_modulus * trace * trace);
-            }
-        }
+        tets.for_each_tet(
+          [&](unsigned int, const unsigned int p, const std::size_t c)
+          {
+            const PartitionedTets::Part &part    = tets.part(p);
+            const Matrix3                F       = part.deformation_gradient(c, x);
+            const Matrix3                R       = rotation_of(F);
+            double                       stretch = 0, trace = -3;
+            for (unsigned int k = 0; k < 9; ++k)
+              stretch += (F[k] - R[k]) * (F[k] - R[k]);
+            for (unsigned int k = 0; k < 9; ++k)
+              trace += R[k] * F[k];
+            energy +=
+              part.rest_volume[c] * part.youngs_modulus[c]
+              * (mu_per_modulus * stretch + 0.5 * lambda_per_modulus * trace * trace);
+          });
         return energy;
       }
 
@@ -196,13 +192,8 @@ namespace lacerta::physics
         const std::function<void(unsigned int, const ElementStiffness &)> &visit)
         const override
       {
-        for (unsigned int p = 0; p < ranges.n_parts(); ++p)
-        {
-          const PartitionedTets::Part &part = tets.part(p);
-          for (std::size_t c = 0; c < part.size(); ++c)
-            if (part.owned[c] & 1u)
-              visit(part.tet[c], rotated_stiffness(*system.mesh, p, c, x));
-        }
+        tets.for_each_tet([&](unsigned int t, unsigned int p, std::size_t c)
+                          { visit(t, rotated_stiffness(*system.mesh, p, c, x)); });
       }
 
       void

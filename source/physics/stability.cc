@@ -572,8 +572,6 @@ namespace lacerta::physics
                                    const double                     time,
                                    const std::string               &cause)
   {
-    std::ostringstream what;
-    what << cause << " at step " << step << ", time " << time << " s";
     check_finite(system, &changed, step, time, " (right after " + cause + ")");
     // New particles enter the work of the loads from where they are now.
     const std::size_t n = system.position.size();
@@ -582,7 +580,11 @@ namespace lacerta::physics
     previous_load.resize(n, 0.0);
     load.resize(n, 0.0);
     if (pending_change.empty())
+    {
+      std::ostringstream what;
+      what << cause << " at step " << step << ", time " << time << " s";
       pending_change = what.str();
+    }
   }
 
 

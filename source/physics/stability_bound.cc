@@ -34,34 +34,25 @@ namespace lacerta::physics
     if (n > leaves)
       build_tree(n);
     // A particle's bound depends on its springs and tetrahedra and on its neighbours'
-    // masses: the changed particles (each once: `changed` repeats them) and every
-    // vertex of their stars are bounded again. Marks below `seed` are old, `seed`
-    // marks a changed particle, `seed + 1` a row.
-    const unsigned int seed = mark + 1;
-    mark += 2;
+    // masses: the changed particles and every vertex of their stars are bounded again.
+    ++mark;
     row_mark.resize(n, 0);
-    seeds.clear();
-    for (const unsigned int p : changed)
-      if (row_mark[p] < seed)
-      {
-        row_mark[p] = seed;
-        seeds.push_back(p);
-      }
     rows.clear();
-    for (const unsigned int p : seeds)
+    const auto add_row = [&](const unsigned int v)
+    {
+      if (row_mark[v] != mark)
+      {
+        row_mark[v] = mark;
+        rows.push_back(v);
+      }
+    };
+    for (const unsigned int p : changed)
+    {
+      add_row(p);
       for (const unsigned int t : system.mesh->tets_of_vertex(p))
         for (const unsigned int v : system.mesh->tet(t))
-          if (row_mark[v] != mark)
-          {
-            row_mark[v] = mark;
-            rows.push_back(v);
-          }
-    for (const unsigned int p : seeds)
-      if (row_mark[p] != mark)
-      {
-        row_mark[p] = mark;
-        rows.push_back(p);
-      }
+          add_row(v);
+    }
     row_lambda.resize(rows.size());
     row_spring.resize(rows.size());
     gershgorin_rows(system,

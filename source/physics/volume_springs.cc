@@ -175,14 +175,8 @@ namespace lacerta::physics
       elastic_energy(const ParticleSystem &system, const double *x) const override
       {
         double energy = LinearSprings::elastic_energy(system, x);
-        for (unsigned int p = 0; p < ranges.n_parts(); ++p)
-        {
-          const PartitionedTets::Part &part = tets.part(p);
-          for (std::size_t c = 0; c < part.size(); ++c)
-            // Each tetrahedron once: in the range that owns its local vertex 0.
-            if (part.owned[c] & 1u)
-              energy += element_energy(part, c, x);
-        }
+        tets.for_each_tet([&](unsigned int, unsigned int p, std::size_t c)
+                          { energy += element_energy(tets.part(p), c, x); });
         return energy;
       }
 
@@ -193,13 +187,8 @@ namespace lacerta::physics
         const std::function<void(unsigned int, const ElementStiffness &)> &visit)
         const override
       {
-        for (unsigned int p = 0; p < ranges.n_parts(); ++p)
-        {
-          const PartitionedTets::Part &part = tets.part(p);
-          for (std::size_t c = 0; c < part.size(); ++c)
-            if (part.owned[c] & 1u)
-              visit(part.tet[c], element_stiffness(part, c, x));
-        }
+        tets.for_each_tet([&](unsigned int t, unsigned int p, std::size_t c)
+                          { visit(t, element_stiffness(tets.part(p), c, x)); });
       }
 
       void

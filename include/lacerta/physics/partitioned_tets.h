@@ -155,6 +155,20 @@ namespace lacerta::physics
     }
 
     /**
+     * Calls @p visit(t, p, c) once for every tetrahedron t, with its copy c in the
+     * range p that owns its local vertex 0, range by range.
+     */
+    template <typename Visit>
+    void
+    for_each_tet(const Visit &visit) const
+    {
+      for (unsigned int p = 0; p < parts.size(); ++p)
+        for (std::size_t c = 0; c < parts[p].size(); ++c)
+          if (parts[p].owned[c] & 1u)
+            visit(parts[p].tet[c], p, c);
+    }
+
+    /**
      * Calls @p visit(t, p, c) for every tetrahedron t of @p list with one of its
      * copies, index c of range p (the copies of a tetrahedron are alike but for the
      * vertices they own).

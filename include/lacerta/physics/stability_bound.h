@@ -75,9 +75,9 @@ namespace lacerta::physics
     unsigned int                  leaves = 0;
     static constexpr unsigned int none   = static_cast<unsigned int>(-1);
 
-    /// The changed particles of an update, once each, and its rows (they and their
-    /// neighbours), marked in `row_mark`.
-    std::vector<unsigned int> seeds, rows, row_mark;
+    /// The rows of an update (the changed particles and their neighbours), marked
+    /// in `row_mark` with the update's `mark`.
+    std::vector<unsigned int> rows, row_mark;
     unsigned int              mark = 0;
     std::vector<double>       row_lambda;
     std::vector<unsigned int> row_spring;
