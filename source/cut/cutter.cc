@@ -1,5 +1,6 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/cut/cutter.h>
+#include <lacerta/cut/predicates.h>
 #include <lacerta/physics/assembly.h>
 #include <lacerta/physics/particle_system.h>
 
@@ -18,16 +19,12 @@ namespace lacerta::cut
   {
     using Clock = std::chrono::steady_clock;
 
-    /// How far (in typical edges) behind its start line a sweep's plane still cuts
-    /// once the stroke has cut: rounding only. The part behind the last front is cut
-    /// already (by the earlier plane, which differs at a corner of the path). The
-    /// first cut of a stroke that plunged into the tissue reaches back one edge, so
-    /// that the crack does not start inside a cell (the table has one front only).
-    constexpr double start_tolerance = 1e-9;
-
-    /// A blade motion that turns by more than this (radians, about 17 degrees) away
-    /// from the direction since the crack front makes a corner of the path.
-    constexpr double corner_angle = 0.3;
+    /// Two sweeps are the same part of the swept surface, for the sides of the
+    /// vertices next to it, when their normals are less than 45 degrees apart: the
+    /// blade cutting on along a path that bends gradually. A sharper turn (a corner,
+    /// a path that comes back across its own cut) is another part, on which the
+    /// vertices' sides are decided anew.
+    constexpr double same_part_cosine = 0.7071067811865476;
 
     /// The local faces of its parent that local node @p n of a child lies on, one bit
     /// per face.
@@ -48,23 +45,6 @@ namespace lacerta::cut
       }
       return 0;
     }
-
-    /// The local edges of face f's sides (face vertex k to k + 1): a table, since the
-    /// analysis looks them up for every face of the affected cells.
-    constexpr std::array<std::array<unsigned int, 3>, 4>
-    make_face_edges()
-    {
-      std::array<std::array<unsigned int, 3>, 4> edges{};
-      for (unsigned int f = 0; f < 4; ++f)
-        for (unsigned int k = 0; k < 3; ++k)
-        {
-          const auto &fv = mesh::TetMesh::face_vertices[f];
-          edges[f][k] =
-            static_cast<unsigned int>(tet_edge_of_vertices[fv[k]][fv[(k + 1) % 3]]);
-        }
-      return edges;
-    }
-    constexpr std::array<std::array<unsigned int, 3>, 4> face_edges = make_face_edges();
 
     /// Barycentric coordinates of the rest point @p rest in cell @p t of @p mesh:
     /// the weights that carry it, with the cell's affine map, to the deformed state.
@@ -123,8 +103,6 @@ namespace lacerta::cut
       , integral_of_density(integral)
       , parameters(parameters_in)
       , current(initial)
-      , front(initial)
-      , last_end(initial)
   {
     // The split table is built on first use (about 10 ms): now, so that the first cut
     // of a run does not wait for it.
@@ -137,17 +115,15 @@ namespace lacerta::cut
     mesh.reserve(room(mesh.n_vertices()), room(mesh.n_tets()));
     system.reserve(room(system.n_particles()));
     system.springs.reserve(room(system.springs.size()));
-    vertex_scratch.reserve(room(mesh.n_vertices()));
     on_surface.reserve(room(mesh.n_vertices()));
-    joined_at.reserve(room(mesh.n_vertices()));
-    swept.reserve(room(mesh.n_vertices()));
-    crossing_pending.reserve(room(mesh.n_vertices()));
+    crossings_at.reserve(room(mesh.n_vertices()));
+    separate_mark.reserve(room(mesh.n_vertices()));
     edge_scratch.reserve(room(mesh.n_edges()));
     edge_stamp.reserve(room(mesh.n_edges()));
     face_scratch.reserve(4 * room(mesh.n_tets()));
     tet_mark.reserve(room(mesh.n_tets()));
     tet_stamp.reserve(room(mesh.n_tets()));
-    partial_child.reserve(room(mesh.n_tets()));
+    in_star.reserve(room(mesh.n_tets()));
     std::vector<double> lengths;
     for (const auto &e : mesh.get_edges())
       lengths.push_back(norm(sub(mesh.vertex(e[1]), mesh.vertex(e[0]))));
@@ -183,12 +159,16 @@ namespace lacerta::cut
       if (v < on_surface.size())
         on_surface[v] = 0;
     on_surface_list.clear();
-    front_edges.clear();
-    // Cells made by partial splits and vertices swept belong to this stroke only.
+    // The crossings decided in the stroke and not applied (the surface ended inside
+    // their cells: a partial stroke) are forgotten: the next stroke decides anew.
+    for (const auto &[key, crossing] : crossings)
+    {
+      --crossings_at[edge_end(key, 0)];
+      --crossings_at[edge_end(key, 1)];
+    }
+    crossings.clear();
+    // The vertices' sides belong to this stroke.
     ++stroke;
-    stroke_has_cut = false;
-    after_corner   = false;
-    corner_pending = false;
   }
 
 
@@ -342,12 +322,39 @@ namespace lacerta::cut
     const unsigned int n = std::max(
       1u, static_cast<unsigned int>(std::ceil(advance / (parameters.max_advance * h))));
     const Blade start = current;
+    // The tissue moves between blade motions: a crossing just ahead of where the last
+    // motion ended can be carried behind where this one starts, and no sweep would
+    // meet it. The first sweep therefore starts behind the blade by as far as the
+    // tissue around it moved since (the overlap is harmless: a crossing seen twice
+    // the same way is one crossing).
+    Blade  from = start;
+    double back = 0;
+    for (const auto &[v, x] : blade_cell_positions)
+      if (v < mesh.n_vertices())
+        back = std::max(back, norm(sub(position(v), x)));
+    const Point motion =
+      sub(scale(0.5, add(next.tail, next.head)), scale(0.5, add(start.tail, start.head)));
+    if (back > 0 && norm(motion) > 0)
+    {
+      const Point shift = scale(back / norm(motion), motion);
+      from.tail         = sub(from.tail, shift);
+      from.head         = sub(from.head, shift);
+    }
     for (unsigned int k = 1; k <= n; ++k)
     {
-      const double s = double(k) / n;
-      sweep({lerp(start.tail, next.tail, s), lerp(start.head, next.head, s)}, statistics);
+      const double s  = double(k) / n;
+      const Blade  to = {lerp(start.tail, next.tail, s), lerp(start.head, next.head, s)};
+      sweep(from, to, statistics);
+      from = to;
     }
     current = next;
+    // The blade has left the tissue (it is in no cell): the stroke is over.
+    if (active.empty())
+      end_stroke();
+    blade_cell_positions.clear();
+    for (const unsigned int t : active)
+      for (const unsigned int v : mesh.tet(t))
+        blade_cell_positions.push_back({v, position(v)});
     if (statistics.changed)
     {
       const auto t0 = Clock::now();
@@ -361,734 +368,452 @@ namespace lacerta::cut
 
 
   void
-  Cutter::sweep(const Blade &end, CutStepStatistics &statistics)
-  {
-    // A corner: the front lags behind the blade (it waits in a cell made by a partial
-    // split, see below) and the blade turns away from the direction since the front.
-    // A sweep from the waiting front to the blade would cut a chord across the corner
-    // (and, crossing the crack's cells diagonally, often nothing at all, leaving the
-    // corner uncut): the front is first brought to the corner, without waiting, so
-    // that the next side starts from the corner line.
-    // A catch-up that was postponed is retried towards the same corner: towards where
-    // the blade was at the next sweep instead, the front would cut a chord across it.
-    const auto  mid = [](const Blade &b) { return scale(0.5, add(b.tail, b.head)); };
-    const Point a = sub(mid(last_end), mid(front)), b = sub(mid(end), mid(last_end));
-    if (!corner_pending && norm(a) > 1e-12 * typical_edge && norm(b) > 0
-        && dot(a, b) < std::cos(corner_angle) * norm(a) * norm(b))
-    {
-      corner         = last_end;
-      corner_pending = true;
-    }
-    if (corner_pending)
-    {
-      catching_up = true;
-      sweep_once(corner, statistics);
-      catching_up = false;
-      if (front.tail == corner.tail)
-      {
-        corner_pending = false;
-        after_corner   = true;
-      }
-    }
-    sweep_once(end, statistics);
-    // The first sweep of the new side that advances the front ends the corner.
-    if (front.tail == end.tail)
-      after_corner = false;
-    last_end = end;
-  }
-
-
-  void
-  Cutter::sweep_once(const Blade &end, CutStepStatistics &statistics)
+  Cutter::sweep(const Blade &from, const Blade &to, CutStepStatistics &statistics)
   {
     ++statistics.sweeps;
-    const Blade                              &s               = front;
     const std::array<std::array<Point, 3>, 2> swept_triangles = {
-      {{{s.tail, s.head, end.tail}}, {{end.tail, s.head, end.head}}}};
+      {{{from.tail, from.head, to.tail}}, {{to.tail, from.head, to.head}}}};
     const auto t_search = Clock::now();
-    find_tets_to_cut(swept_triangles, end);
+    find_tets_to_cut(swept_triangles, to);
     statistics.search_seconds +=
       std::chrono::duration<double>(Clock::now() - t_search).count();
     active.swap(next_active);
     if (candidates.empty())
     {
       // Out of the tissue: the stroke is over.
-      front = end;
       end_stroke();
       return;
     }
-
-    // The cut surface of this sweep in the deformed configuration: the plane through
-    // the last crack front along the motion, and the new crack front.
-    SweepSurface surface;
-    surface.motion =
-      sub(scale(0.5, add(end.tail, end.head)), scale(0.5, add(s.tail, s.head)));
-    Point normal = cross(sub(s.head, s.tail), surface.motion);
-    if (!(norm(normal) > 1e-12 * norm(sub(s.head, s.tail)) * norm(surface.motion)))
-    {
-      // The blade moved along itself: it sweeps no surface.
-      front = end;
-      return;
-    }
-    surface.normal    = normalized(normal);
-    surface.origin    = s.tail;
-    surface.end_tail  = end.tail;
-    surface.front_dir = normalized(cross(surface.normal, sub(end.head, end.tail)));
-    if (dot(surface.front_dir, surface.motion) < 0)
-      surface.front_dir = scale(-1, surface.front_dir);
-    // The start line is the last front: in the plane, perpendicular to it, towards
-    // the motion.
-    surface.start_dir = normalized(cross(surface.normal, sub(s.head, s.tail)));
-    if (dot(surface.start_dir, surface.motion) < 0)
-      surface.start_dir = scale(-1, surface.start_dir);
-    const double eps = parameters.snap_fraction;
-    start_reach      = (stroke_has_cut ? start_tolerance : 1.0) * typical_edge;
-
     const auto t_start = Clock::now();
     lap_start          = t_start;
-    const auto spent   = [&]
-    {
-      statistics.update_seconds +=
-        std::chrono::duration<double>(Clock::now() - t_start).count();
-    };
     prepare_scratch();
-    // The affected set: C, closed under the stars of cut edges, front faces and
-    // vertices joining the crack (all of which must be split alike).
-    ++affected_stamp;
-    affected = candidates;
-    for (const unsigned int t : affected)
-      tet_mark[t] = affected_stamp;
-    // The crack tip stays where the last applied sweep left it, inside the cells of
-    // the edges its plane crossed ahead of its front; the tissue moves meanwhile, and
-    // those crossings can fall behind this sweep's start line, where a sweep does not
-    // cut: the cell around the tip would stay whole and bridge the sides (square_hole
-    // held still: the square stayed attached at its last corner in 5 of 30 runs whose
-    // blade path differed by 1e-13 m). They are cut wherever the plane meets them,
-    // and their cells join the set even if the swept surface has moved off them. Not
-    // at a corner, where the crack turns and the part behind the start line belongs
-    // to the other side.
-    front_edge_ids.clear();
-    if (!catching_up && !after_corner)
-      for (const auto &ends : front_edges)
-      {
-        const unsigned int id = mesh.find_edge(ends[0], ends[1]);
-        if (id == mesh::invalid_index)
-          continue;
-        front_edge_ids.push_back(id);
-        around.clear();
-        mesh.tets_around_edge(ends[0], ends[1], around);
-        for (const unsigned int n : around)
-          join_affected(n);
-      }
-    std::sort(front_edge_ids.begin(), front_edge_ids.end());
-    analyse(surface);
-    // One TetCut per affected tetrahedron; split them all before changing anything.
-    removed.clear();
-    cuts.clear();
-    for (const unsigned int t : affected)
-    {
-      const mesh::Tet &tet = mesh.tet(t);
-      TetCut           c;
-      bool             touched = false;
-      for (unsigned int i = 0; i < 4; ++i)
-      {
-        c.vertex_ids[i]  = tet[i];
-        c.points[i]      = mesh.vertex(tet[i]);
-        c.vertex_side[i] = vertex_scratch[tet[i]].side;
-        touched |= vertex_scratch[tet[i]].star_stamp == star_stamp;
-      }
-      for (unsigned int e = 0; e < 6; ++e)
-      {
-        const EdgeScratch &es = edge_scratch[mesh.tet_edges(t)[e]];
-        if (es.reached)
-        {
-          c.cut_edges |= std::uint8_t(1u << e);
-          c.edge_parameter[e] = es.t;
-          touched             = true;
-        }
-      }
-      for (unsigned int f = 0; f < 4; ++f)
-      {
-        const FaceScratch &fs = face_scratch[4 * t + f];
-        if (fs.has_front())
-        {
-          c.front_faces |= std::uint8_t(1u << f);
-          c.front_points[f] = front_rest[fs.front];
-          touched           = true;
-        }
-      }
-      if (touched)
-      {
-        removed.push_back(t);
-        cuts.push_back(c);
-      }
-    }
+    record_crossings(swept_triangles);
+    select_cells();
+    make_cuts();
     lap(statistics.analysis_seconds);
-    if (removed.empty())
+    if (!removed.empty())
     {
-      // Nothing to split: the front stays where the crack is (see below).
-      if (!stroke_has_cut)
-        front = end;
-      spent();
-      return;
+      results.resize(cuts.size());
+      for (std::size_t k = 0; k < cuts.size(); ++k)
+        split_tetrahedron(cuts[k], results[k], parameters.snap_fraction);
+      lap(statistics.split_seconds);
+      forget_applied_crossings();
+      apply(to, statistics);
     }
-    results.resize(cuts.size());
-    bool separates = false, any_cut = false;
-    for (std::size_t k = 0; k < cuts.size(); ++k)
-    {
-      const CutKind kind = split_tetrahedron(cuts[k], results[k], eps);
-      // Postponed (the crack front waits; the next sweep, from the same front, covers
-      // more): a configuration the table does not describe; a second partial split of
-      // a cell the front has not left yet (it is continued when the front leaves it,
-      // by the complete split of the children ahead of the old front, instead of
-      // being re-split at every sweep); a child flat at rest (a vertex kept on the
-      // surface lies within ε of the plane, not on it); a partial split that would
-      // make a sliver next to a vertex ahead of the front.
-      // (When the blade has left the tissue, or turned at a corner of its path, the
-      // front must catch up where it is: no deferral and no waiting for a better
-      // front.)
-      const bool must_follow = active.empty() || catching_up;
-      bool       postpone    = kind == CutKind::unsupported
-                      || (kind == CutKind::partial && partial_child[removed[k]] == stroke
-                          && !must_follow)
-                      || has_flat_child(cuts[k], results[k]);
-      if (!postpone && !must_follow
-          && (kind == CutKind::partial || kind == CutKind::refinement))
-      {
-        double shortest_parent = 1e300;
-        for (const auto &e : tet_edge_vertices)
-          shortest_parent =
-            std::min(shortest_parent,
-                     norm(sub(cuts[k].points[e[1]], cuts[k].points[e[0]])));
-        postpone = shortest_child_edge(cuts[k], results[k]) < 0.5 * eps * shortest_parent;
-      }
-      if (postpone)
-      {
-        ++statistics.postponed;
-        lap(statistics.split_seconds);
-        spent();
-        return;
-      }
-      separates |= kind == CutKind::complete || kind == CutKind::partial;
-      any_cut |= kind != CutKind::none && kind != CutKind::touch;
-    }
-    lap(statistics.split_seconds);
-    if (!separates && !any_cut)
-    {
-      bool any_edge = false;
-      for (const unsigned int e : edge_list)
-        any_edge |= edge_scratch[e].reached;
-      if (!any_edge)
-      {
-        // Only touching and nothing joins the crack: nothing to change yet.
-        bool joins = false;
-        for (const unsigned int v : verts)
-          joins |= vertex_scratch[v].star_stamp == star_stamp;
-        for (const unsigned int v : group_extra)
-          joins |= vertex_scratch[v].star_stamp == star_stamp;
-        if (!joins)
-        {
-          // Once the stroke has cut, the front stays where the crack is: a blade that
-          // crosses an opened crack (a gap) or cuts inside one cell must not carry the
-          // front past tissue it has not cut, since a sweep does not cut behind its
-          // start line.
-          if (!stroke_has_cut)
-            front = end;
-          spent();
-          return;
-        }
-      }
-    }
-    apply(end, statistics);
-    stroke_has_cut = true;
-    spent();
-    front = end;
-  }
-
-
-  bool
-  Cutter::has_flat_child(const TetCut &cut, const SplitResult &result) const
-  {
-    // A child below 1e-6 of the parent's longest edge cubed is flat. At a corner of
-    // the path the crack bends inside a cell, and a front point clamped off the
-    // corner line (the line may run through a mesh face) leaves thin cells there:
-    // they are accepted down to 1e-8, still a hundred times above what
-    // check_invariants() calls flat, rather than postponing the new side forever.
-    const double flat_volume = catching_up || after_corner ? 1e-8 : 1e-6;
-    // One square root (the root is monotone: the same value as the longest norm).
-    double longest_squared = 0;
-    for (const auto &e : tet_edge_vertices)
-    {
-      const Point d   = sub(cut.points[e[1]], cut.points[e[0]]);
-      longest_squared = std::max(longest_squared, dot(d, d));
-    }
-    const double longest_parent = std::sqrt(longest_squared);
-    for (unsigned int i = 0; i < result.n_children; ++i)
-    {
-      const auto p = child_node_points(cut, result, result.children[i]);
-      if (!(volume(p[0], p[1], p[2], p[3])
-            > flat_volume * longest_parent * longest_parent * longest_parent))
-        return true;
-    }
-    return false;
+    statistics.update_seconds +=
+      std::chrono::duration<double>(Clock::now() - t_start).count();
   }
 
 
   void
   Cutter::prepare_scratch()
   {
-    vertex_scratch.resize(mesh.n_vertices());
     edge_scratch.resize(mesh.n_edges());
     face_scratch.resize(4 * std::size_t(mesh.n_tets()));
     tet_mark.resize(mesh.n_tets(), 0);
-    partial_child.resize(mesh.n_tets(), 0);
+    in_star.resize(mesh.n_tets(), 0);
     if (on_surface.size() < mesh.n_vertices())
       on_surface.resize(mesh.n_vertices(), 0);
-    if (joined_at.size() < mesh.n_vertices())
-      joined_at.resize(mesh.n_vertices());
-    swept.resize(mesh.n_vertices(), 0);
-    crossing_pending.resize(mesh.n_vertices(), 0);
-  }
-
-
-  Cutter::VertexScratch &
-  Cutter::vertex_data(const unsigned int v, const SweepSurface &surface)
-  {
-    VertexScratch &s = vertex_scratch[v];
-    if (s.stamp == analysis_stamp)
-      return s;
-    s.stamp  = analysis_stamp;
-    s.parent = v;
-    // Each pass of the analysis starts from the sweep's own judgement (the snapping
-    // and the patches of a pass change on_plane and reached), which depends on the
-    // sweep only: it is computed in the first pass that meets the vertex.
-    if (s.sweep_stamp == affected_stamp)
-    {
-      s.on_plane = s.sweep_on_plane;
-      s.reached  = s.sweep_reached;
-      return s;
-    }
-    s.sweep_stamp = affected_stamp;
-    const Point x = position(v);
-    double      d = surface.distance(x);
-    if (std::abs(d) <= 1e-12 * typical_edge)
-      d = 0;
-    s.d = d;
-    // A vertex of the stroke's crack was put on the cut surface where the blade was
-    // then; the crack opens behind the front (the sides move apart across the plane
-    // as the stretched tissue relaxes, by several millimetres in square_hole), so
-    // where it is now says little about whether a plane that continues the cut holds
-    // it. Whether it is on the plane, and reached, is judged where it joined the crack.
-    // The same holds for a fresh vertex an earlier sweep of the stroke put on the
-    // plane and swept (a postponed sweep, or one whose patch waited): it stays
-    // reached, and is judged where it was swept. Judged where it is now, the tissue
-    // carried it off the plane (square_hole's third side: 0.9 mm, beyond ε of an edge)
-    // while the front waited, and the sweep that finally applied put it on one side
-    // behind its start line, where no crossing is cut, next to cells the earlier
-    // sweeps had split with it on the plane: the cell between stayed whole and
-    // bridged the sides.
-    const double tolerance = parameters.snap_fraction * typical_edge;
-    const bool   was_swept = !on_surface[v] && swept[v] == stroke;
-    Point        at        = on_surface[v] || was_swept ? joined_at[v] : x;
-    bool         on_crack =
-      (on_surface[v] || was_swept) && std::abs(surface.distance(at)) <= tolerance;
-    // Where the flap twists (square_hole's fourth side crossing the first side's
-    // crack), neither place puts a crack vertex on the plane: it is then judged in
-    // the rest frame of the tissue the blade is in, where crack vertices never move
-    // (the plane meets the crack where it did at rest). The vertex's rest position
-    // is mapped through the deformation of the blade's cells (the mean of their
-    // affine maps), so that the test compares rest geometry in world units. Not while
-    // the front is brought to a corner or has just turned there: the blade's cells
-    // then hold the other side's crack (with the test there too, square_hole's third
-    // corner stayed uncut between rest x = -0.0125 and -0.02).
-    if (on_surface[v] && !on_crack && !active.empty() && !catching_up && !after_corner)
-    {
-      const Point &rest   = mesh.vertex(v);
-      Point        mapped = {{0, 0, 0}};
-      for (const unsigned int t : active)
-      {
-        const mesh::Tet &c = mesh.tet(t);
-        const auto       l = rest_barycentric(mesh, t, rest);
-        for (unsigned int i = 0; i < 4; ++i)
-          mapped = add(mapped, scale(l[i] / active.size(), position(c[i])));
-      }
-      if (std::abs(surface.distance(mapped)) <= tolerance)
-      {
-        on_crack = true;
-        at       = mapped;
-      }
-    }
-    s.on_plane = d == 0 || on_crack;
-    // Reached: a vertex of the crack when behind the new front; a fresh one when also
-    // not behind the start of this sweep by more than a cell (the plane must not
-    // reach back along an older part of the crack), or when an earlier sweep of the
-    // stroke swept it. While the front is brought to a corner, a vertex of the crack
-    // in the plane up to a quarter of an edge beyond the corner is reached too: where
-    // a closed path comes back to its start, the corner is where the blade turned
-    // between two steps, short of the crack's first vertices; a face in the plane
-    // through one of them was cut only up to the corner, the next side's plane (which
-    // turns away) never met the rest of it, and it held the disc (a closed
-    // Catmull-Rom circle and a polygon of 64 sides per turn punched nothing).
-    const double beyond = surface.behind(at);
-    s.reached =
-      on_surface[v]
-        ? beyond < 0 || (catching_up && on_crack && beyond < 0.25 * typical_edge)
-        : (surface.behind(x) < 0 && surface.ahead_of_start(x) >= -start_reach)
-            || swept[v] == stroke;
-    s.sweep_on_plane = s.on_plane;
-    s.sweep_reached  = s.reached;
-    return s;
+    if (separate_mark.size() < mesh.n_vertices())
+      separate_mark.resize(mesh.n_vertices(), 0);
+    fresh_mark.resize(std::max(fresh_mark.size(), on_surface.size()), 0);
+    crossings_at.resize(mesh.n_vertices(), 0);
   }
 
 
   void
-  Cutter::analyse(const SweepSurface &surface)
+  Cutter::record_crossings(const std::array<std::array<Point, 3>, 2> &swept_triangles)
   {
     const double eps = parameters.snap_fraction;
-    // The closure is a fixed point: each pass adds the cells that must be split with
-    // the set (around reached crossings, the stars of vertices joining the crack, the
-    // neighbours across front faces), at least one per pass, so it ends within the
-    // cells next to the swept surface. The number of passes grows with the cells
-    // along the front; any fixed cap postpones every sweep of a fine enough mesh.
-    while (true)
+    new_crossings.clear();
+    new_on_surface.clear();
+    // The orientation of this part of the swept surface.
+    Point normal = cross(sub(swept_triangles[0][1], swept_triangles[0][0]),
+                         sub(swept_triangles[0][2], swept_triangles[0][0]));
+    if (!(norm(normal) > 0))
+      normal = cross(sub(swept_triangles[1][1], swept_triangles[1][0]),
+                     sub(swept_triangles[1][2], swept_triangles[1][0]));
+    if (!(norm(normal) > 0))
+      return; // the blade moved along itself: it sweeps no surface
+    normal         = normalized(normal);
+    sweep_triangle = swept_triangles[0];
+    ++analysis_stamp;
+    for (const unsigned int t : candidates)
+      for (unsigned int e = 0; e < 6; ++e)
+      {
+        EdgeScratch &es = edge_scratch[mesh.tet_edges(t)[e]];
+        if (es.stamp == analysis_stamp)
+          continue;
+        es.stamp       = analysis_stamp;
+        unsigned int a = mesh.tet(t)[tet_edge_vertices[e][0]];
+        unsigned int b = mesh.tet(t)[tet_edge_vertices[e][1]];
+        if (b < a)
+          std::swap(a, b);
+        // An edge with an end on the cut is never cut: the cut passes through the end.
+        if (on_surface[a] || on_surface[b])
+          continue;
+        const Crossing crossing = edge_crossing(a, b, swept_triangles, normal);
+        if (crossing.side == 0)
+          continue;
+        // The ends' sides are decided for this part of the surface.
+        keep_side(a, crossing.side, normal);
+        keep_side(b, std::int8_t(-crossing.side), normal);
+        const std::uint64_t key = edge_key(a, b);
+        const auto          it  = crossings.find(key);
+        if (it != crossings.end())
+        {
+          // Crossed again in the same direction, or at the same place (within ε of
+          // the edge): the same crossing, seen by two sweeps (their triangles share
+          // lines, and the tissue moves between blade motions) or by the blade going
+          // back over its cut; the first decision stands. In the opposite direction
+          // elsewhere along the edge: the edge went into the swept surface and out
+          // again (through a corner of the path, or a path that comes back), so its
+          // ends lie on one side: no crossing.
+          if (it->second.side != crossing.side
+              && std::abs(it->second.t - crossing.t) >= eps)
+          {
+            crossings.erase(it);
+            --crossings_at[a];
+            --crossings_at[b];
+            new_crossings.push_back(key);
+          }
+          continue;
+        }
+        // Snapping, once: an end closer to the swept surface than ε times the edge's
+        // length is put on the cut (the edge is then not cut), unless a crossing of
+        // another of its edges was decided before. Then no cut point lies within ε of
+        // an end, and an edge nearly in the surface (a blade along a face) does not
+        // shave a sliver off it.
+        const bool snap_a = crossing.distance[0] < eps && may_snap(a);
+        const bool snap_b = crossing.distance[1] < eps && may_snap(b);
+        if (snap_a)
+          put_on_surface(a);
+        if (snap_b)
+          put_on_surface(b);
+        if (snap_a || snap_b)
+          continue;
+        crossings.emplace(key, crossing);
+        ++crossings_at[a];
+        ++crossings_at[b];
+        new_crossings.push_back(key);
+      }
+  }
+
+
+  Cutter::Crossing
+  Cutter::edge_crossing(const unsigned int                         a,
+                        const unsigned int                         b,
+                        const std::array<std::array<Point, 3>, 2> &swept_triangles,
+                        const Point                               &normal) const
+  {
+    const Point pa = position(a), pb = position(b);
+    for (const auto &tri : swept_triangles)
     {
-      ++analysis_stamp;
-      verts.clear();
-      edge_list.clear();
-      front_rest.clear();
-      for (const unsigned int t : affected)
+      // The ends' sides: as decided for this part of the surface (the tissue may have
+      // carried an end across the blade's plane since), or where they are now,
+      // exactly (a point on the plane counts as on the positive side).
+      const auto side_now = [&](const unsigned int v, const Point &x)
       {
-        const mesh::Tet &tet = mesh.tet(t);
-        for (const unsigned int v : tet)
-          if (vertex_scratch[v].stamp != analysis_stamp)
-          {
-            vertex_data(v, surface);
-            verts.push_back(v);
-          }
-        for (const unsigned int e : mesh.tet_edges(t))
-          if (edge_scratch[e].stamp != analysis_stamp)
-          {
-            edge_scratch[e].stamp    = analysis_stamp;
-            edge_scratch[e].crossing = false;
-            edge_scratch[e].reached  = false;
-            edge_list.push_back(e);
-          }
-      }
-      const auto &edges = mesh.get_edges();
-      // Snapping: a vertex on the surface (exactly, kept from earlier sweeps of the
-      // stroke, or snapped by a crossing close to it) has no cut edge.
-      for (const unsigned int e : edge_list)
-      {
-        VertexScratch &a = vertex_scratch[edges[e][0]], &b = vertex_scratch[edges[e][1]];
-        if (!a.on_plane && !b.on_plane && a.d * b.d < 0)
-        {
-          const EdgeSnap snap = snap_edge_parameter(a.d / (a.d - b.d), eps);
-          if (snap == EdgeSnap::first_vertex)
-            a.on_plane = true;
-          else if (snap == EdgeSnap::second_vertex)
-            b.on_plane = true;
-        }
-      }
-      // Vertices on the surface joined by edges in the surface are reached together
-      // (the front never crosses such an edge): the whole connected patch, followed
-      // beyond the affected cells through the vertex stars, waits until all of it
-      // has been swept. Its vertices outside the affected set join it when reached.
-      group_extra.clear();
-      const auto root = [&](unsigned int v)
-      {
-        while (vertex_scratch[v].parent != v)
-          v = vertex_scratch[v].parent = vertex_scratch[vertex_scratch[v].parent].parent;
-        return v;
+        const std::int8_t kept = kept_side(v, normal);
+        return kept != 0
+                 ? kept
+                 : (orientation(tri[0], tri[1], tri[2], x) >= 0 ? std::int8_t(1)
+                                                                : std::int8_t(-1));
       };
-      // Inside the affected cells: the edges in the surface.
-      for (const unsigned int e : edge_list)
-        if (vertex_scratch[edges[e][0]].on_plane && vertex_scratch[edges[e][1]].on_plane)
-          vertex_scratch[root(edges[e][0])].parent = root(edges[e][1]);
-      // Beyond them, from the fresh vertices on the plane (not yet on the crack: the
-      // crack already made is reached and need not be walked) through their stars.
-      group.clear();
-      for (const unsigned int v : verts)
-        if (vertex_scratch[v].on_plane && !on_surface[v])
-          group.push_back(v);
-      for (std::size_t q = 0; q < group.size(); ++q)
-      {
-        const unsigned int u = group[q];
-        for (const unsigned int t : mesh.tets_of_vertex(u))
-        {
-          if (tet_mark[t] == affected_stamp)
-            continue;
-          for (const unsigned int w : mesh.tet(t))
-          {
-            if (w == u || on_surface[w])
-              continue;
-            const bool     is_new = vertex_scratch[w].stamp != analysis_stamp;
-            VertexScratch &s      = vertex_data(w, surface);
-            if (!s.on_plane)
-              continue;
-            if (is_new)
-            {
-              group_extra.push_back(w);
-              group.push_back(w);
-            }
-            vertex_scratch[root(w)].parent = root(u);
-          }
-        }
-      }
-      for (const unsigned int v : verts)
-        vertex_scratch[v].group_reached = true;
-      for (const unsigned int v : group_extra)
-        vertex_scratch[v].group_reached = true;
-      const auto gather = [&](const unsigned int v)
-      {
-        VertexScratch &s = vertex_scratch[v];
-        if (!s.on_plane)
-          return;
-        if (s.reached && !on_surface[v])
-        {
-          // Where it was first swept: later sweeps judge it there (vertex_data()).
-          if (swept[v] != stroke)
-            joined_at[v] = position(v);
-          swept[v] = stroke;
-        }
-        if (!s.reached)
-          vertex_scratch[root(v)].group_reached = false;
-      };
-      for (const unsigned int v : verts)
-        gather(v);
-      for (const unsigned int v : group_extra)
-        gather(v);
-      for (const unsigned int v : verts)
-        if (vertex_scratch[v].on_plane)
-          vertex_scratch[v].reached = vertex_scratch[root(v)].group_reached;
-      for (const unsigned int v : group_extra)
-        vertex_scratch[v].reached = vertex_scratch[root(v)].group_reached;
-      for (const unsigned int v : verts)
-      {
-        VertexScratch &s = vertex_scratch[v];
-        s.side           = s.on_plane && s.reached ? 0 : (s.d >= 0 ? 1 : -1);
-        // A vertex of the crack that this stroke's plane reaches only now (where the
-        // path crosses its own crack): its star must be re-split, so that the faces
-        // in the plane through it open.
-        if (s.on_plane && on_surface[v] && !s.reached)
-          crossing_pending[v] = stroke;
-      }
-      for (const unsigned int v : group_extra)
-      {
-        VertexScratch &s = vertex_scratch[v];
-        s.side           = s.on_plane && s.reached ? 0 : (s.d >= 0 ? 1 : -1);
-      }
-      // Crossings of the surface; the reached ones are cut.
-      for (const unsigned int e : edge_list)
-      {
-        EdgeScratch         &es = edge_scratch[e];
-        const VertexScratch &a  = vertex_scratch[edges[e][0]],
-                            &b  = vertex_scratch[edges[e][1]];
-        if (a.on_plane || b.on_plane || !(a.d * b.d < 0))
-          continue;
-        es.t          = a.d / (a.d - b.d);
-        const Point p = lerp(position(edges[e][0]), position(edges[e][1]), es.t);
-        if (surface.ahead_of_start(p) < -start_reach
-            && !std::binary_search(front_edge_ids.begin(), front_edge_ids.end(), e))
-          continue;
-        es.crossing = true;
-        es.reached  = surface.behind(p) < 0;
-      }
-      // Front points, once per face, from the face's two section corners.
-      for (const unsigned int t : affected)
-      {
-        // A front point lies between a reached and an unreached corner (a vertex on
-        // the plane or a crossing): a cell without both, as most cells behind the
-        // front, has none on any face.
-        bool any_reached = false, any_unreached = false;
-        for (const unsigned int v : mesh.tet(t))
-          if (vertex_scratch[v].on_plane)
-            (vertex_scratch[v].reached ? any_reached : any_unreached) = true;
-        for (const unsigned int e : mesh.tet_edges(t))
-          if (edge_scratch[e].crossing)
-            (edge_scratch[e].reached ? any_reached : any_unreached) = true;
-        for (unsigned int f = 0; f < 4; ++f)
-        {
-          FaceScratch &fs = face_scratch[4 * t + f];
-          if (fs.stamp == analysis_stamp)
-            continue;
-          fs.stamp = analysis_stamp;
-          fs.front = FaceScratch::no_front;
-          if (any_reached && any_unreached)
-            compute_front_point(t, f, surface, fs);
-          // The face seen from the neighbour gets the same front point.
-          const unsigned int n = mesh.neighbor(t, f);
-          if (n != mesh::invalid_index)
-            for (unsigned int g = 0; g < 4; ++g)
-              if (mesh.neighbor(n, g) == t)
-              {
-                face_scratch[4 * n + g].stamp = fs.stamp;
-                face_scratch[4 * n + g].front = fs.front;
-              }
-        }
-      }
-      // Closure: everything that must be split alike has to be in the set.
-      missing.clear();
-      ++star_stamp;
-      for (const unsigned int e : edge_list)
-        if (edge_scratch[e].reached)
-        {
-          // Usually every cell around the edge is in the set already: the smaller
-          // star of the two ends tells. Otherwise the cells are listed in the mesh's
-          // order, as before.
-          const unsigned int a = edges[e][0], b = edges[e][1];
-          bool               outside = false;
-          mesh.visit_tets_with_edge(a,
-                                    b,
-                                    [&](const unsigned int n, unsigned int)
-                                    {
-                                      outside = tet_mark[n] != affected_stamp;
-                                      return outside;
-                                    });
-          if (!outside)
-            continue;
-          around.clear();
-          mesh.tets_around_edge(a, b, around);
-          for (const unsigned int n : around)
-            if (tet_mark[n] != affected_stamp)
-              missing.push_back(n);
-        }
-      // A vertex joining the crack needs its whole star (its copies are decided on
-      // it): a vertex newly on the surface, one of a cell that is cut now, or one of
-      // the crack that the plane reaches only now (see crossing_pending). Old
-      // crack vertices elsewhere stay as they are, so the set does not spread along
-      // the whole crack.
-      for (const unsigned int t : affected)
-      {
-        const bool is_cut = tet_is_cut(t);
-        for (const unsigned int v : mesh.tet(t))
-          if (vertex_scratch[v].side == 0
-              && (is_cut || !on_surface[v] || crossing_pending[v] == stroke))
-            vertex_scratch[v].star_stamp = star_stamp;
-      }
-      for (const unsigned int v : group_extra)
-        if (vertex_scratch[v].side == 0 && !on_surface[v])
-          vertex_scratch[v].star_stamp = star_stamp;
-      for (const unsigned int v : verts)
-        if (vertex_scratch[v].star_stamp == star_stamp)
-          for (const unsigned int n : mesh.tets_of_vertex(v))
-            if (tet_mark[n] != affected_stamp)
-              missing.push_back(n);
-      for (const unsigned int v : group_extra)
-        if (vertex_scratch[v].star_stamp == star_stamp)
-          for (const unsigned int n : mesh.tets_of_vertex(v))
-            if (tet_mark[n] != affected_stamp)
-              missing.push_back(n);
-      for (const unsigned int t : affected)
-        for (unsigned int f = 0; f < 4; ++f)
-          if (face_scratch[4 * t + f].has_front())
-          {
-            const unsigned int n = mesh.neighbor(t, f);
-            if (n != mesh::invalid_index && tet_mark[n] != affected_stamp)
-              missing.push_back(n);
-          }
-      if (missing.empty())
-        return;
-      for (const unsigned int n : missing)
-        join_affected(n);
+      const std::int8_t sa = side_now(a, pa), sb = side_now(b, pb);
+      if (sa == sb || !line_meets_triangle(pa, pb, tri[0], tri[1], tri[2]))
+        continue;
+      // Where (the decision above is exact; the place only needs to be close): the
+      // parameter from a, the end with the smaller id, the same at rest as deformed.
+      const Point  n  = cross(sub(tri[1], tri[0]), sub(tri[2], tri[0]));
+      const double da = dot(n, sub(pa, tri[0])), db = dot(n, sub(pb, tri[0]));
+      const double t = da == db ? 0.5 : std::clamp(da / (da - db), 0.0, 1.0);
+      // The ends' distances from the surface's plane, in edge lengths.
+      const double scale = norm(n) * norm(sub(pb, pa));
+      Crossing     c{t, sa, false, {{1, 1}}};
+      if (scale > 0)
+        c.distance = {{std::abs(da) / scale, std::abs(db) / scale}};
+      return c;
     }
+    return {};
+  }
+
+
+  std::int8_t
+  Cutter::kept_side(const unsigned int v, const Point &normal) const
+  {
+    if (v >= side_records.size())
+      return 0;
+    const SideRecord &r = side_records[v];
+    return r.stroke == stroke && dot(r.normal, normal) > same_part_cosine ? r.side : 0;
   }
 
 
   void
-  Cutter::join_affected(const unsigned int t)
+  Cutter::keep_side(const unsigned int v, const std::int8_t side, const Point &normal)
   {
-    if (tet_mark[t] != affected_stamp)
-    {
-      tet_mark[t] = affected_stamp;
-      affected.push_back(t);
-    }
+    if (side_records.size() <= v)
+      side_records.resize(std::size_t(v) + 256);
+    if (kept_side(v, normal) == 0)
+      side_records[v] = {side, stroke, normal};
   }
 
 
   bool
-  Cutter::tet_is_cut(const unsigned int t) const
+  Cutter::may_snap(const unsigned int v) const
   {
-    for (const unsigned int e : mesh.tet_edges(t))
-      if (edge_scratch[e].reached)
-        return true;
-    for (unsigned int f = 0; f < 4; ++f)
-      if (face_scratch[4 * t + f].has_front())
-        return true;
-    return false;
+    // Not if a crossing of another of its edges was decided (it lies off the cut),
+    // nor if a cell around it would have all four vertices on the cut: such a cell
+    // lies in the crack and would be cut off from both sides, a fragment.
+    if (crossings_at[v] != 0)
+      return false;
+    for (const unsigned int t : mesh.tets_of_vertex(v))
+    {
+      unsigned int others_on_cut = 0;
+      for (const unsigned int w : mesh.tet(t))
+        others_on_cut += w != v && on_surface[w];
+      if (others_on_cut == 3)
+        return false;
+    }
+    return true;
   }
 
 
   void
-  Cutter::compute_front_point(const unsigned int  t,
-                              const unsigned int  f,
-                              const SweepSurface &surface,
-                              FaceScratch        &fs)
+  Cutter::put_on_surface(const unsigned int v)
   {
-    const mesh::Tet                  &tet = mesh.tet(t);
-    const auto                       &fv  = mesh::TetMesh::face_vertices[f];
-    const std::array<unsigned int, 3> v{{tet[fv[0]], tet[fv[1]], tet[fv[2]]}};
-    const auto                       &edge_ids = mesh.tet_edges(t);
-    // Most faces have no front point: front_point_on_face() wants a segment (two
-    // corners) between a reached and an unreached corner, not two vertex corners.
-    // Counting the corners first spares those faces the interpolations.
+    mark_on_surface(v);
+    new_on_surface.push_back(v);
+  }
+
+
+  Cutter::CellDecision
+  Cutter::decide_cell(const unsigned int t) const
+  {
+    const mesh::Tet           &tet = mesh.tet(t);
+    CellDecision               d;
+    std::array<bool, 4>        zero;
+    std::array<std::int8_t, 6> side_of_smaller{};
+    for (unsigned int i = 0; i < 4; ++i)
+      zero[i] = on_surface[tet[i]] != 0;
+    for (unsigned int e = 0; e < 6; ++e)
     {
-      unsigned int n = 0, n_vertex = 0, n_reached = 0;
-      for (unsigned int k = 0; k < 3; ++k)
-      {
-        const VertexScratch &vs = vertex_scratch[v[k]];
-        if (vs.on_plane)
-        {
-          ++n;
-          ++n_vertex;
-          n_reached += vs.reached ? 1 : 0;
-        }
-      }
-      for (unsigned int k = 0; k < 3 && n < 3; ++k)
-      {
-        const EdgeScratch &es = edge_scratch[edge_ids[face_edges[f][k]]];
-        if (es.crossing)
-        {
-          ++n;
-          n_reached += es.reached ? 1 : 0;
-        }
-      }
-      if (n != 2 || n_reached != 1 || n_vertex == 2)
-        return;
-    }
-    std::array<SectionCorner, 3> corners;
-    unsigned int                 n_corners = 0, vertex_corners = 0;
-    for (unsigned int k = 0; k < 3; ++k)
-      if (vertex_scratch[v[k]].on_plane)
-      {
-        corners[n_corners++] = {mesh.vertex(v[k]),
-                                position(v[k]),
-                                vertex_scratch[v[k]].reached};
-        ++vertex_corners;
-      }
-    for (unsigned int k = 0; k < 3 && n_corners < 3; ++k)
-    {
-      const unsigned int a  = std::min(v[k], v[(k + 1) % 3]),
-                         b  = std::max(v[k], v[(k + 1) % 3]);
-      const EdgeScratch &es = edge_scratch[edge_ids[face_edges[f][k]]];
-      if (!es.crossing)
+      const unsigned int i = tet_edge_vertices[e][0], j = tet_edge_vertices[e][1];
+      if (zero[i] || zero[j])
         continue;
-      corners[n_corners++] = {lerp(mesh.vertex(a), mesh.vertex(b), es.t),
-                              lerp(position(a), position(b), es.t),
-                              es.reached};
+      const auto it = crossings.find(edge_key(tet[i], tet[j]));
+      if (it == crossings.end())
+        continue;
+      d.crossed |= std::uint8_t(1u << e);
+      d.t[e]             = it->second.t;
+      side_of_smaller[e] = it->second.side;
     }
-    Point rest, now;
-    if (front_point_on_face(
-          corners.data(),
-          n_corners,
-          vertex_corners,
-          [&](const Point &x) { return surface.behind(x); },
-          parameters.snap_fraction,
-          rest,
-          now))
+    if (d.crossed == 0)
+      return d;
+    // The two sides: a crossed edge joins vertices on opposite sides, its end with
+    // the smaller id on the side the crossing recorded; an edge not crossed joins
+    // vertices on the same side. The cell is cut through when that is consistent:
+    // then its sides are those of the surface's orientation, the same in every cell.
+    unsigned int first_edge = 0;
+    while (!((d.crossed >> first_edge) & 1u))
+      ++first_edge;
     {
-      fs.front = static_cast<unsigned int>(front_rest.size());
-      front_rest.push_back(rest);
+      const unsigned int i            = tet_edge_vertices[first_edge][0],
+                         j            = tet_edge_vertices[first_edge][1];
+      const std::int8_t s             = side_of_smaller[first_edge];
+      d.side[tet[i] < tet[j] ? i : j] = s;
+      d.side[tet[i] < tet[j] ? j : i] = std::int8_t(-s);
+      for (unsigned int k = 0; k < 4; ++k)
+        if (k != i && k != j && !zero[k])
+          d.side[k] = (d.crossed >> tet_edge_of_vertices[i][k]) & 1u
+                        ? std::int8_t(-d.side[i])
+                        : d.side[i];
     }
+    bool consistent = true;
+    for (unsigned int e = 0; e < 6; ++e)
+    {
+      const unsigned int i = tet_edge_vertices[e][0], j = tet_edge_vertices[e][1];
+      if (zero[i] || zero[j])
+        continue;
+      if ((d.crossed >> e) & 1u)
+        consistent &=
+          d.side[tet[i] < tet[j] ? i : j] == side_of_smaller[e] && d.side[i] != d.side[j];
+      else
+        consistent &= d.side[i] == d.side[j];
+    }
+    d.complete = consistent && d.crossed != 0;
+    return d;
+  }
+
+
+  void
+  Cutter::select_cells()
+  {
+    ++affected_stamp;
+    affected.clear();
+    applied_crossings.clear();
+    const auto consider = [&](const unsigned int t)
+    {
+      if (tet_mark[t] != affected_stamp)
+      {
+        tet_mark[t] = affected_stamp;
+        in_star[t]  = 0;
+        affected.push_back(t);
+      }
+    };
+    const auto consider_edge = [&](const std::uint64_t key)
+    {
+      around.clear();
+      mesh.tets_around_edge(edge_end(key, 0), edge_end(key, 1), around);
+      for (const unsigned int n : around)
+        consider(n);
+    };
+    // The cells whose copies of @p v are decided again: its whole star.
+    const auto separate = [&](const unsigned int v)
+    {
+      if (separate_mark[v] == affected_stamp)
+        return;
+      separate_mark[v] = affected_stamp;
+      for (const unsigned int n : mesh.tets_of_vertex(v))
+      {
+        consider(n);
+        in_star[n] = 1;
+      }
+    };
+    for (const std::uint64_t key : new_crossings)
+      if (mesh.find_edge(edge_end(key, 0), edge_end(key, 1)) != mesh::invalid_index)
+        consider_edge(key);
+    new_on_surface.insert(new_on_surface.end(), adopted.begin(), adopted.end());
+    adopted.clear();
+    for (const unsigned int v : new_on_surface)
+      fresh_mark[v] = affected_stamp;
+    for (const unsigned int v : new_on_surface)
+      separate(v);
+    // The closure: a cell cut through applies its crossings, and every cell around
+    // an applied crossing is split with it (conforming: it is refined through the
+    // cut point if the surface does not cross it through yet); the vertices on the
+    // cut in a cell cut through get their copies decided over their whole stars.
+    for (std::size_t q = 0; q < affected.size(); ++q)
+    {
+      const unsigned int t   = affected[q];
+      const mesh::Tet   &tet = mesh.tet(t);
+      // A face whose last vertex came onto the cut in this sweep lies in the cut from
+      // now on: the copies of all three of its vertices are decided again.
+      for (const auto &fv : mesh::TetMesh::face_vertices)
+        if (on_surface[tet[fv[0]]] && on_surface[tet[fv[1]]] && on_surface[tet[fv[2]]]
+            && (fresh_mark[tet[fv[0]]] == affected_stamp
+                || fresh_mark[tet[fv[1]]] == affected_stamp
+                || fresh_mark[tet[fv[2]]] == affected_stamp))
+          for (const unsigned int k : fv)
+            separate(tet[k]);
+      const CellDecision d = decide_cell(t);
+      if (!d.complete)
+        continue;
+      for (unsigned int e = 0; e < 6; ++e)
+        if ((d.crossed >> e) & 1u)
+        {
+          const std::uint64_t key =
+            edge_key(tet[tet_edge_vertices[e][0]], tet[tet_edge_vertices[e][1]]);
+          Crossing &c = crossings.find(key)->second;
+          if (!c.applied)
+          {
+            c.applied = true;
+            applied_crossings.push_back(key);
+            consider_edge(key);
+          }
+        }
+      for (const unsigned int v : tet)
+        if (on_surface[v])
+          separate(v);
+    }
+  }
+
+
+  void
+  Cutter::make_cuts()
+  {
+    removed.clear();
+    cuts.clear();
+    for (const unsigned int t : affected)
+    {
+      const CellDecision d   = decide_cell(t);
+      const mesh::Tet   &tet = mesh.tet(t);
+      TetCut             c   = whole_cell(t);
+      if (d.complete)
+        for (unsigned int i = 0; i < 4; ++i)
+          c.vertex_side[i] = d.side[i];
+      for (unsigned int e = 0; e < 6; ++e)
+        if ((d.crossed >> e) & 1u)
+        {
+          const bool applied = d.complete
+                               || crossings
+                                    .find(edge_key(tet[tet_edge_vertices[e][0]],
+                                                   tet[tet_edge_vertices[e][1]]))
+                                    ->second.applied;
+          if (applied)
+          {
+            c.cut_edges |= std::uint8_t(1u << e);
+            c.edge_parameter[e] = d.t[e];
+          }
+        }
+      // A cell that is neither cut nor refined nor in the star of a vertex whose
+      // copies are decided stays as it is.
+      if (c.cut_edges == 0 && !in_star[t])
+        continue;
+      removed.push_back(t);
+      cuts.push_back(c);
+    }
+  }
+
+
+  TetCut
+  Cutter::whole_cell(const unsigned int t) const
+  {
+    // Its vertices off the cut on one side: the side they were found on, or for those
+    // the stroke has not judged, their side of the sweep's plane (a face whose last
+    // vertex came onto the cut in this sweep lies in that plane), if they agree, so
+    // that the faces the table flags face the surface's orientation (the MT's update
+    // orients the cut surface by it).
+    const mesh::Tet &tet      = mesh.tet(t);
+    std::int8_t      one_side = 0;
+    bool             agree    = true;
+    for (const unsigned int v : tet)
+      if (!on_surface[v])
+      {
+        const std::int8_t side =
+          v < side_records.size() && side_records[v].stroke == stroke
+            ? side_records[v].side
+            : (orientation(
+                 sweep_triangle[0], sweep_triangle[1], sweep_triangle[2], position(v))
+                   >= 0
+                 ? std::int8_t(1)
+                 : std::int8_t(-1));
+        agree &= one_side == 0 || one_side == side;
+        one_side = side;
+      }
+    if (one_side == 0 || !agree)
+      one_side = 1;
+    TetCut c;
+    for (unsigned int i = 0; i < 4; ++i)
+    {
+      c.vertex_ids[i]  = tet[i];
+      c.points[i]      = mesh.vertex(tet[i]);
+      c.vertex_side[i] = on_surface[tet[i]] ? 0 : one_side;
+    }
+    return c;
+  }
+
+
+  void
+  Cutter::forget_applied_crossings()
+  {
+    for (const std::uint64_t key : applied_crossings)
+    {
+      crossings.erase(key);
+      --crossings_at[edge_end(key, 0)];
+      --crossings_at[edge_end(key, 1)];
+    }
+    applied_crossings.clear();
   }
 
 
@@ -1100,12 +825,6 @@ namespace lacerta::cut
     // a spring whose edge dies is retired with it). Every spring gets these terms
     // first and those of the new tetrahedra after, in the order of the cells.
     physics::SpringSet &springs = system.springs;
-    // The edges this sweep's plane crosses ahead of its front, by their ends (the
-    // update renumbers edges): the next sweep cuts them wherever the plane meets them.
-    front_edges.clear();
-    for (const unsigned int e : edge_list)
-      if (edge_scratch[e].crossing && !edge_scratch[e].reached)
-        front_edges.push_back(mesh.get_edges()[e]);
     touched_vertices.clear();
     double integral_delta = 0;
     // A constant density and Young's modulus (the common case) need no Function call
@@ -1220,9 +939,9 @@ namespace lacerta::cut
                 es.point       = {
                         {mesh::invalid_index, mesh::invalid_index, mesh::invalid_index}};
               }
-              // The side of the copy this child uses (point_key()'s side of an edge
-              // point).
-              slot = &es.point[n.side + 1];
+              // One point per edge: its copies, where the crack opens, are decided
+              // with the vertices on the cut (below).
+              slot = &es.point[1];
               break;
             }
             case NodeKind::face_point:
@@ -1248,7 +967,7 @@ namespace lacerta::cut
             *slot         = new_particle(p, parent);
             if (record)
             {
-              CutRecord::NewPoint point{*slot, n.kind, 0, {}, p};
+              CutRecord::NewPoint point{*slot, n.kind, {}, p};
               if (n.kind == NodeKind::interior_point)
               {
                 for (unsigned int m = 0; m < 4; ++m)
@@ -1258,7 +977,6 @@ namespace lacerta::cut
               else
               {
                 const auto key = point_key(c.vertex_ids, n, parent);
-                point.side     = key.side;
                 for (unsigned int m = 0; m < 3; ++m)
                   point.ids[m] = static_cast<unsigned int>(key.ids[m]);
               }
@@ -1277,7 +995,12 @@ namespace lacerta::cut
                   }
             }
             if (n.kind != NodeKind::interior_point)
+            {
               mark_on_surface(*slot);
+              if (separate_mark.size() <= *slot)
+                separate_mark.resize(std::size_t(*slot) + 256, 0);
+              separate_mark[*slot] = affected_stamp;
+            }
           }
           t[j] = *slot;
         }
@@ -1306,7 +1029,6 @@ namespace lacerta::cut
           child_origin.push_back({{static_cast<unsigned int>(k), i}});
         child_cut_faces.push_back(child.cut_faces);
         face_ids.push_back(fid);
-        child_partial.push_back(r.kind == CutKind::partial);
       }
     }
     // Vertices on the cut: one copy per group of their children connected through
@@ -1315,8 +1037,7 @@ namespace lacerta::cut
     incidences.clear();
     for (std::size_t k = 0; k < children.size(); ++k)
       for (const unsigned int v : children[k])
-        if (v < vertex_scratch.size() && vertex_scratch[v].stamp == analysis_stamp
-            && vertex_scratch[v].star_stamp == star_stamp)
+        if (v < separate_mark.size() && separate_mark[v] == affected_stamp)
           incidences.push_back({{v, static_cast<unsigned int>(k)}});
     std::sort(incidences.begin(), incidences.end());
     for (std::size_t b = 0; b < incidences.size();)
@@ -1349,7 +1070,7 @@ namespace lacerta::cut
         copy_ids[g] = copy;
         if (record)
           record->new_points.push_back(
-            {copy, NodeKind::vertex, 0, {{v, 0, 0, 0}}, mesh.vertex(v)});
+            {copy, NodeKind::vertex, {{v, 0, 0, 0}}, mesh.vertex(v)});
       }
       for (std::size_t i = 0; i < star.size(); ++i)
       {
@@ -1415,13 +1136,7 @@ namespace lacerta::cut
       for (unsigned int f2 = 0; f2 < 4; ++f2)
         if (mesh.neighbor(t, f2) == mesh::invalid_index)
           tree.add_face(mesh, t, f2);
-      // Children of a partial split are not split partially again in this stroke.
-      partial_child[t] = child_partial[k] ? stroke : 0;
     }
-    child_partial.clear();
-    for (const unsigned int v : verts)
-      if (vertex_scratch[v].star_stamp == star_stamp && v < crossing_pending.size())
-        crossing_pending[v] = 0;
     // A vertex that lost all its cells cannot happen (copies take over whole stars),
     // but a mass that rounding left a hair below zero would be nonsense: clamp. A mass
     // further below zero is a particle that gave mass to its neighbours
@@ -1476,10 +1191,13 @@ namespace lacerta::cut
   void
   Cutter::adopt_crack(const std::vector<unsigned int> &crack)
   {
+    // Their copies are decided again in the next sweep (the faces between them lie
+    // in the cut): where the crack was closed, it opens.
     for (const unsigned int v : crack)
     {
       AssertIndexRange(v, mesh.n_vertices());
       mark_on_surface(v);
+      adopted.push_back(v);
     }
   }
 
@@ -1493,9 +1211,6 @@ namespace lacerta::cut
       on_surface.resize(std::size_t(mesh.n_vertices()) + 256, 0);
     if (!on_surface[v])
     {
-      if (v >= joined_at.size())
-        joined_at.resize(std::size_t(mesh.n_vertices()) + 256);
-      joined_at[v]  = position(v);
       on_surface[v] = 1;
       on_surface_list.push_back(v);
     }

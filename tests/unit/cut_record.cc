@@ -72,7 +72,7 @@ namespace lacerta
           ASSERT_EQ(p.id, n_vertices++);
           EXPECT_EQ(p.position, m.vertex(p.id));
           if (p.kind != NodeKind::vertex)
-            point_of[{p.kind, p.side, p.ids}] = p.id;
+            point_of[{p.kind, 0, p.ids}] = p.id;
         }
         for (const auto &c : record.vertex_choices)
           choice[{{c.cut, c.child, c.node}}] = c.used;
@@ -120,10 +120,14 @@ namespace lacerta
                                          : n.kind == NodeKind::face_point ? 3
                                                                           : 4;
               std::sort(ids.begin(), ids.begin() + count);
-              const auto it =
-                point_of.find({n.kind, n.kind == NodeKind::edge_point ? n.side : 0, ids});
+              // One particle per edge or face; where the crack opens, the copy of it
+              // a child uses is recorded like a vertex's.
+              const auto it = point_of.find({n.kind, 0, ids});
               ASSERT_NE(it, point_of.end()) << "a child's point has no recorded particle";
-              child[j] = it->second;
+              child[j]          = it->second;
+              const auto chosen = choice.find({{k, i, j}});
+              if (chosen != choice.end())
+                child[j] = chosen->second;
             }
             current.insert(sorted(child));
           }

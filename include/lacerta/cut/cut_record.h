@@ -21,7 +21,8 @@ namespace lacerta::cut
    * faces of the children) and the crack front (the front points) follow from `cuts`;
    * the cut points on edges are exact and keyed by the edge's two vertex ids. What the
    * table leaves to the cutter is recorded explicitly: the ids of the particles it
-   * created, with their keys, and which copy of a vertex on the cut each side uses.
+   * created, with their keys, and which copy of a point on the cut (a vertex or a cut
+   * point) each child uses.
    */
   struct CutRecord
   {
@@ -30,11 +31,10 @@ namespace lacerta::cut
     {
       /// Its vertex id in the cut mesh.
       unsigned int id = 0;
-      /// Cut point on an edge, front point on a face, interior point, or a copy of a
-      /// vertex on the cut (NodeKind::vertex).
+      /// Cut point on an edge (one per edge: where the crack opens at it, its copies
+      /// are recorded like those of a vertex on the cut), front point on a face,
+      /// interior point, or a copy of a point on the cut (NodeKind::vertex).
       NodeKind kind = NodeKind::vertex;
-      /// Side of an edge point's or a vertex copy's sheet (+1, -1), 0 otherwise.
-      std::int8_t side = 0;
       /**
        * The key's vertex ids, sorted: the edge's two, the face's three, the four of the
        * split tetrahedron for an interior point, the copied vertex for a copy; unused

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <unordered_map>
 #include <vector>
 
 namespace dealii
@@ -169,59 +170,53 @@ namespace lacerta::cut
     }
 
   private:
-    /// The cut surface of one sweep (deformed configuration): the plane through the
-    /// last crack front along the motion, bounded by the new front.
-    struct SweepSurface
+    /**
+     * A crossing of a mesh edge by the stroke's swept surface, decided once when the
+     * blade sweeps it: where (the parameter along the edge from its end with the
+     * smaller id, the same at rest as deformed) and which way (the side of the
+     * surface that end lies on, +1 or -1; 0: no crossing).
+     */
+    struct Crossing
     {
-      Point origin{}, normal{}, motion{}, start_dir{}, front_dir{}, end_tail{};
-
-      /// Signed distance from the plane.
-      double
-      distance(const Point &x) const
-      {
-        return dot(normal, sub(x, origin));
-      }
-
-      /// Negative behind the new front (where the crack is).
-      double
-      behind(const Point &x) const
-      {
-        return dot(front_dir, sub(x, end_tail));
-      }
-
-      /// How far ahead of the sweep's start line (the last front), in the plane.
-      double
-      ahead_of_start(const Point &x) const
-      {
-        return dot(start_dir, sub(x, origin));
-      }
+      double      t    = 0;
+      std::int8_t side = 0;
+      /// Whether the sweep being applied cuts the edge.
+      bool applied = false;
+      /// When decided: the distances of the ends from the surface's plane, in edge
+      /// lengths (for the snapping).
+      std::array<double, 2> distance{};
     };
-
-    /// Per-vertex scratch of the analysis, valid where `stamp` is the current one.
-    /// What depends on the sweep only (distance, and on-plane and reached before the
-    /// snapping and the patches) is kept for the sweep (`sweep_stamp`), so that the
-    /// closure's later passes do not recompute it.
-    struct VertexScratch
+    /**
+     * What the crossings decided so far make of one cell: the crossed local edges and
+     * their parameters, and whether they cut it through (its vertices off the cut
+     * fall into two sides, each crossed edge joining the two), with the sides.
+     */
+    struct CellDecision
     {
-      unsigned int stamp = 0, star_stamp = 0;
-      /// Union-find parent (a vertex id) of the patch of on-plane vertices.
-      unsigned int parent      = 0;
-      unsigned int sweep_stamp = 0;
-      double       d           = 0;
-      bool         on_plane = false, reached = false, group_reached = false;
-      bool         sweep_on_plane = false, sweep_reached = false;
-      std::int8_t  side = 0;
+      std::uint8_t               crossed = 0;
+      std::array<double, 6>      t{};
+      std::array<std::int8_t, 4> side{};
+      bool                       complete = false;
     };
-
+    /// The key of the edge between vertices @p a < @p b in `crossings`.
+    static std::uint64_t
+    edge_key(const unsigned int a, const unsigned int b)
+    {
+      return (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+    }
+    /// End @p i (0: the smaller id) of the edge with key @p key.
+    static unsigned int
+    edge_end(const std::uint64_t key, const unsigned int i)
+    {
+      return static_cast<unsigned int>(i == 0 ? key >> 32 : key & 0xFFFFFFFFu);
+    }
     /// Per-edge scratch: crossing, cut parameter, and the new particles on the edge
     /// (one per side -1, 0, +1) while children are made. Ordered for 32 bytes: two
     /// edges per cache line (the analysis reads it at random edge ids).
     struct EdgeScratch
     {
-      double                      t     = 0;
       unsigned int                stamp = 0, point_stamp = 0;
       std::array<unsigned int, 3> point{};
-      bool                        crossing = false, reached = false;
     };
 
     /// Per-face-slot (4 t + f) scratch: the front point (an index into `front_rest`)
@@ -242,67 +237,69 @@ namespace lacerta::cut
       }
     };
 
-    /// One sweep from the last applied crack front to @p end; at a corner of the
-    /// path, first a sweep that brings the front to the corner.
+    /// One sweep of the blade from @p from to @p to: crossings, cells, split, update.
     void
-    sweep(const Blade &end, CutStepStatistics &statistics);
-
-    /// One sweep from the last applied crack front to @p end, a straight motion.
-    void
-    sweep_once(const Blade &end, CutStepStatistics &statistics);
-
+    sweep(const Blade &from, const Blade &to, CutStepStatistics &statistics);
     /// FindTetraToCut: fills `candidates` (C) and `next_active` (A_t+1).
     void
     find_tets_to_cut(const std::array<std::array<Point, 3>, 2> &swept, const Blade &end);
-
     /// Whether tetrahedron @p t meets the swept triangles (deformed configuration).
     bool
     tet_meets(unsigned int t, const std::array<std::array<Point, 3>, 2> &swept) const;
-
     /// Whether the segment (blade) meets tetrahedron @p t.
     bool
     blade_in_tet(unsigned int t, const Blade &b) const;
-
     /// Current position of particle @p v.
     Point
     position(unsigned int v) const;
-
-    /// Ends the stroke: vertices on the cut lose that status.
+    /// Ends the stroke: vertices on the cut lose that status, undecided crossings go.
     void
     end_stroke();
-
     /// Grows the scratch arrays to the mesh (new entries are invalid).
     void
     prepare_scratch();
-
-    /// The scratch of vertex @p v, computed for @p surface if not yet in this pass.
-    VertexScratch &
-    vertex_data(unsigned int v, const SweepSurface &surface);
-
-    /// Sides, cut edges and front points on `affected`, closed under what must be
-    /// split alike.
+    /// Decides, once, the crossings of the edges of the candidate cells by the swept
+    /// triangles, and the vertices the surface passes through (snapping).
     void
-    analyse(const SweepSurface &surface);
-
-    /// The front point of face @p f of tetrahedron @p t, into @p fs.
+    record_crossings(const std::array<std::array<Point, 3>, 2> &swept_triangles);
+    /// How the edge from @p a to @p b (a < b) crosses the swept triangles, whose unit
+    /// normal is @p normal, exactly.
+    Crossing
+    edge_crossing(unsigned int                               a,
+                  unsigned int                               b,
+                  const std::array<std::array<Point, 3>, 2> &swept_triangles,
+                  const Point                               &normal) const;
+    /// The side vertex @p v was given for the part of the surface with unit normal
+    /// @p normal in this stroke, or 0.
+    std::int8_t
+    kept_side(unsigned int v, const Point &normal) const;
+    /// Vertex @p v lies on side @p side of the part of the surface with unit normal
+    /// @p normal, unless a side was decided for that part already.
     void
-    compute_front_point(unsigned int        t,
-                        unsigned int        f,
-                        const SweepSurface &surface,
-                        FaceScratch        &fs);
-
-    /// Adds tetrahedron @p t to the affected set unless it is there already.
-    void
-    join_affected(unsigned int t);
-
-    /// Whether tetrahedron @p t has a cut edge or a front face in the analysis.
+    keep_side(unsigned int v, std::int8_t side, const Point &normal);
+    /// Whether vertex @p v may be put on the cut (snapping).
     bool
-    tet_is_cut(unsigned int t) const;
-
-    /// Whether a child of the split is flat at rest.
-    bool
-    has_flat_child(const TetCut &cut, const SplitResult &result) const;
-
+    may_snap(unsigned int v) const;
+    /// Vertex @p v lies on the cut from now on (decided in this sweep).
+    void
+    put_on_surface(unsigned int v);
+    /// What the decided crossings make of cell @p t.
+    CellDecision
+    decide_cell(unsigned int t) const;
+    /// The cells the sweep splits (`affected`): those the crossings cut through, the
+    /// cells around the crossings they apply, and the stars of the vertices on the cut
+    /// whose copies are decided again.
+    void
+    select_cells();
+    /// One TetCut per cell of `affected` that changes, into `removed` and `cuts`.
+    void
+    make_cuts();
+    /// The TetCut that leaves cell @p t whole (the table flags its faces on the cut).
+    TetCut
+    whole_cell(unsigned int t) const;
+    /// Removes the crossings the sweep applies (their edges are split).
+    void
+    forget_applied_crossings();
     /// Replaces `removed` by the children of `results`, copies the vertices on the
     /// cut, updates masses, springs and the active set.
     void
@@ -327,68 +324,61 @@ namespace lacerta::cut
     std::optional<double> constant_youngs_modulus;
     Parameters            parameters;
     Blade                 current;
-    /// The crack front as last applied: the start of the next swept surface.
-    Blade front;
-    /// Where the blade was at the end of the last sweep tried: a corner of the path
-    /// when the next motion turns away from the direction since the front.
-    Blade last_end;
-    /// Whether the sweep being made brings the front to a corner, and whether the
-    /// front has not advanced since it reached one: children of these sweeps may be
-    /// thin (the crack bends inside a cell; see has_flat_child()).
-    bool catching_up = false, after_corner = false;
-    /// The corner the front is being brought to, while that has not succeeded yet.
-    Blade corner;
-    bool  corner_pending = false;
     /// Typical edge length at rest (median), for the sub-division when nothing is active.
-    double typical_edge = 0;
-    /// The current stroke (from entering the tissue to leaving it), from 1, and
-    /// whether it has cut anything yet.
-    unsigned int stroke         = 1;
-    bool         stroke_has_cut = false;
-    /// How far behind its start line the current sweep's plane cuts.
-    double start_reach = 0;
-
+    double                    typical_edge = 0;
     BoundaryFaceTree          tree;
     std::vector<unsigned int> active, next_active, candidates, queue;
     std::vector<unsigned int> tet_stamp, edge_stamp;
     unsigned int              stamp = 0;
-    /// Vertices on the cut surface of the current stroke (progressive cuts).
-    std::vector<std::uint8_t> on_surface;
-    std::vector<unsigned int> on_surface_list;
-    /// Where each vertex of the stroke's crack was (world) when it joined the crack;
-    /// for a vertex a sweep of the stroke swept on the plane but that is not on the
-    /// crack, where it was first swept. Later sweeps judge the vertex there.
-    std::vector<Point>                  joined_at;
+    /// Vertices on the cut surface of the current stroke.
+    std::vector<std::uint8_t>           on_surface;
+    std::vector<unsigned int>           on_surface_list;
     std::vector<BoundaryFaceTree::Face> hits;
-    /// Stroke in which a vertex on the plane was swept by the blade (its patch opens
-    /// when all of it is swept).
-    std::vector<unsigned int> swept;
-    /// Stroke in which a vertex of the crack lay on the plane ahead of the front (a
-    /// later sweep that reaches it re-splits its star).
-    std::vector<unsigned int> crossing_pending;
-    /// Stroke in which a tetrahedron was made by a partial split (not split partially
-    /// again while the front is inside it).
-    std::vector<unsigned int> partial_child;
-    /// The edges (their ends) that the last applied sweep's plane crossed ahead of its
-    /// front, where the crack tip waits, and their ids in the current sweep (sorted).
-    std::vector<std::array<unsigned int, 2>> front_edges;
-    std::vector<unsigned int>                front_edge_ids;
-
+    /**
+     * The side of the swept surface a vertex next to it was found on, once, in the
+     * stroke `stroke`, for the part of the surface with unit normal `normal`.
+     */
+    struct SideRecord
+    {
+      std::int8_t  side   = 0;
+      unsigned int stroke = 0;
+      Point        normal{};
+    };
+    std::vector<SideRecord> side_records;
+    /// A triangle the current sweep swept (deformed).
+    std::array<Point, 3> sweep_triangle{};
+    /// The vertices of the cells the blade was in at the end of the last motion, with
+    /// their positions then.
+    std::vector<std::pair<unsigned int, Point>> blade_cell_positions;
+    /// The current stroke (from entering the tissue to leaving it), from 1.
+    unsigned int stroke = 1;
+    /// The crossings decided in the current stroke and not applied yet, by edge key.
+    std::unordered_map<std::uint64_t, Crossing> crossings;
+    /// Per vertex, the number of its edges in `crossings`.
+    std::vector<unsigned int> crossings_at;
+    /// The crossings and the vertices on the cut the current sweep decided.
+    std::vector<std::uint64_t> new_crossings;
+    std::vector<unsigned int>  new_on_surface;
+    /// The crossings the current sweep applies.
+    std::vector<std::uint64_t> applied_crossings;
+    /// Vertices of an adopted crack (adopt_crack()) whose copies the next sweep decides.
+    std::vector<unsigned int> adopted;
     // Scratch, kept between sweeps so that no sweep allocates or clears O(mesh).
-    std::vector<VertexScratch> vertex_scratch;
-    std::vector<EdgeScratch>   edge_scratch;
-    std::vector<FaceScratch>   face_scratch;
-    /// The front points (rest configuration) of the analysis pass, by FaceScratch::front.
-    std::vector<Point>        front_rest;
-    std::vector<unsigned int> tet_mark;
-    unsigned int analysis_stamp = 0, star_stamp = 0, affected_stamp = 0, merge_stamp = 0;
-    std::vector<unsigned int> affected, verts, edge_list, group, group_extra, missing,
-      around, removed, added_ids, touched_vertices, star_group, copy_ids;
+    std::vector<EdgeScratch> edge_scratch;
+    std::vector<FaceScratch> face_scratch;
+    /// Per cell: in `affected` (stamp), and in the star of a vertex whose copies are
+    /// decided again. Per vertex: its copies are decided in this sweep (stamp).
+    std::vector<unsigned int> tet_mark, separate_mark;
+    /// Per vertex: came onto the cut in this sweep (stamp).
+    std::vector<unsigned int> fresh_mark;
+    std::vector<std::uint8_t> in_star;
+    unsigned int              analysis_stamp = 0, affected_stamp = 0, merge_stamp = 0;
+    std::vector<unsigned int> affected, around, removed, added_ids, touched_vertices,
+      star_group, copy_ids;
     std::vector<TetCut>                      cuts;
     std::vector<SplitResult>                 results;
     std::vector<mesh::Tet>                   children;
     std::vector<std::uint8_t>                child_cut_faces;
-    std::vector<bool>                        child_partial;
     std::vector<std::array<unsigned int, 4>> face_ids;
     std::vector<std::array<unsigned int, 2>> incidences;
     std::vector<StarCell>                    star;
