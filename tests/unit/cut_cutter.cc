@@ -203,10 +203,8 @@ TEST(CutCutter, RandomStrokesKeepTheInvariants)
     ASSERT_FALSE(::testing::Test::HasFatalFailure()) << "seed " << seed;
     separated += cut::count_components(f.mesh) == 2;
   }
-  // A postponed sweep is retried from the same front, so no bridge is left behind;
-  // a stroke may still end in a configuration where the two sides touch at a vertex
-  // the table keeps (doc/cutting.md), hence 5 of 6 rather than all.
-  EXPECT_GE(separated, 5u);
+  // Every straight stroke through the box cuts every cell it crosses through.
+  EXPECT_EQ(separated, 6u);
 }
 
 

@@ -271,8 +271,8 @@ namespace lacerta
                {vertical(cx - dir[0], cy - dir[1]), vertical(cx + dir[0], cy + dir[1])},
                6 + 2 * seed);
       ASSERT_NO_THROW(c.mt.check("cut MT")) << "seed " << seed;
-      // Where the cutter postponed sweeps and left a bridge (doc/cutting.md), the
-      // MT, cut along the surface the cutter did open, may still separate.
+      // The MT decides the crossings again from the surface the cutter opened, and
+      // may separate where the cutter's mesh did not (doc/reliability.md, "Soak").
       c.expect_lod_follows_the_cut(false);
       const mesh::TetMesh finest = check_extraction(c.mt, *uniform(0), 0, "finest");
       const unsigned int  pieces = cut::count_components(finest);

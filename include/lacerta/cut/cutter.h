@@ -45,10 +45,10 @@ namespace lacerta::cut
   {
     /// Tetrahedra replaced (CuT) and tetrahedra created (CrT).
     unsigned int cut_tets = 0, created_tets = 0;
-    /// Particles created (cut points, front points, copies of vertices on the cut).
+    /// Particles created (cut points, copies of points on the cut).
     unsigned int new_particles = 0;
-    /// Sub-steps of the swept surface, and those whose cut was postponed.
-    unsigned int sweeps = 0, postponed = 0;
+    /// Sub-steps of the swept surface.
+    unsigned int sweeps = 0;
     /// Wall time of the local mesh and physics update, and of the force model's
     /// update for the springs the motion changed (ForceModel::springs_changed()), in
     /// seconds.
@@ -56,10 +56,10 @@ namespace lacerta::cut
     /**
      * Where the time went, in seconds. `search_seconds` (not part of update_seconds):
      * the boundary face tree's refit, the first contact and the propagation
-     * (FindTetraToCut). The parts of update_seconds: `analysis_seconds` (sides, cut
-     * edges, front points, the closure of the affected set, one TetCut per cell),
-     * `split_seconds` (the split table and the checks that postpone a sweep),
-     * `children_seconds` (the children's nodes, new particles, copies of the vertices
+     * (FindTetraToCut). The parts of update_seconds: `analysis_seconds` (the crossings
+     * decided, the cells cut through and the closure around them, one TetCut per cell),
+     * `split_seconds` (the split table),
+     * `children_seconds` (the children's nodes, new particles, copies of the points
      * on the cut), `mesh_seconds` (TetMesh::replace_tets()) and `physics_seconds`
      * (masses, springs, the tree's new faces, the active set).
      */
