@@ -19,6 +19,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <unistd.h>
 
 namespace lacerta::test_support
 {
@@ -32,7 +33,10 @@ namespace lacerta::test_support
                   const std::string &parameters,
                   const unsigned int n_threads = 1)
   {
-    const std::string file = (std::filesystem::temp_directory_path() / name).string();
+    // One file per process: CTest runs the tests that share a name in parallel.
+    const std::string file =
+      (std::filesystem::temp_directory_path() / (std::to_string(::getpid()) + "_" + name))
+        .string();
     std::ofstream(file) << parameters;
     dealii::ParameterHandler prm;
     Simulator::read_parameters(file, prm);
