@@ -120,7 +120,6 @@ namespace lacerta::cut
     separate_mark.reserve(room(mesh.n_vertices()));
     edge_scratch.reserve(room(mesh.n_edges()));
     edge_stamp.reserve(room(mesh.n_edges()));
-    face_scratch.reserve(4 * room(mesh.n_tets()));
     tet_mark.reserve(room(mesh.n_tets()));
     tet_stamp.reserve(room(mesh.n_tets()));
     in_star.reserve(room(mesh.n_tets()));
@@ -161,12 +160,8 @@ namespace lacerta::cut
     on_surface_list.clear();
     // The crossings decided in the stroke and not applied (the surface ended inside
     // their cells: a partial stroke) are forgotten: the next stroke decides anew.
-    for (const auto &[key, crossing] : crossings)
-    {
-      --crossings_at[edge_end(key, 0)];
-      --crossings_at[edge_end(key, 1)];
-    }
-    crossings.clear();
+    for (auto it = crossings.begin(); it != crossings.end();)
+      it = forget_crossing(it);
     // The vertices' sides belong to this stroke.
     ++stroke;
   }
@@ -409,7 +404,6 @@ namespace lacerta::cut
   Cutter::prepare_scratch()
   {
     edge_scratch.resize(mesh.n_edges());
-    face_scratch.resize(4 * std::size_t(mesh.n_tets()));
     tet_mark.resize(mesh.n_tets(), 0);
     in_star.resize(mesh.n_tets(), 0);
     if (on_surface.size() < mesh.n_vertices())
@@ -452,7 +446,8 @@ namespace lacerta::cut
         // An edge with an end on the cut is never cut: the cut passes through the end.
         if (on_surface[a] || on_surface[b])
           continue;
-        const Crossing crossing = edge_crossing(a, b, swept_triangles, normal);
+        std::array<double, 2> distance{};
+        const Crossing crossing = edge_crossing(a, b, swept_triangles, normal, distance);
         if (crossing.side == 0)
           continue;
         // The ends' sides are decided for this part of the surface.
@@ -472,9 +467,7 @@ namespace lacerta::cut
           if (it->second.side != crossing.side
               && std::abs(it->second.t - crossing.t) >= eps)
           {
-            crossings.erase(it);
-            --crossings_at[a];
-            --crossings_at[b];
+            forget_crossing(it);
             new_crossings.push_back(key);
           }
           continue;
@@ -484,8 +477,8 @@ namespace lacerta::cut
         // another of its edges was decided before. Then no cut point lies within ε of
         // an end, and an edge nearly in the surface (a blade along a face) does not
         // shave a sliver off it.
-        const bool snap_a = crossing.distance[0] < eps && may_snap(a);
-        const bool snap_b = crossing.distance[1] < eps && may_snap(b);
+        const bool snap_a = distance[0] < eps && may_snap(a);
+        const bool snap_b = distance[1] < eps && may_snap(b);
         if (snap_a)
           put_on_surface(a);
         if (snap_b)
@@ -504,7 +497,8 @@ namespace lacerta::cut
   Cutter::edge_crossing(const unsigned int                         a,
                         const unsigned int                         b,
                         const std::array<std::array<Point, 3>, 2> &swept_triangles,
-                        const Point                               &normal) const
+                        const Point                               &normal,
+                        std::array<double, 2>                     &distance) const
   {
     const Point pa = position(a), pb = position(b);
     for (const auto &tri : swept_triangles)
@@ -530,10 +524,10 @@ namespace lacerta::cut
       const double t = da == db ? 0.5 : std::clamp(da / (da - db), 0.0, 1.0);
       // The ends' distances from the surface's plane, in edge lengths.
       const double scale = norm(n) * norm(sub(pb, pa));
-      Crossing     c{t, sa, false, {{1, 1}}};
-      if (scale > 0)
-        c.distance = {{std::abs(da) / scale, std::abs(db) / scale}};
-      return c;
+      distance           = scale > 0
+                             ? std::array<double, 2>{{std::abs(da) / scale, std::abs(db) / scale}}
+                             : std::array<double, 2>{{1, 1}};
+      return {t, sa, false};
     }
     return {};
   }
@@ -681,8 +675,7 @@ namespace lacerta::cut
       }
     };
     for (const std::uint64_t key : new_crossings)
-      if (mesh.find_edge(edge_end(key, 0), edge_end(key, 1)) != mesh::invalid_index)
-        consider_edge(key);
+      consider_edge(key);
     new_on_surface.insert(new_on_surface.end(), adopted.begin(), adopted.end());
     adopted.clear();
     for (const unsigned int v : new_on_surface)
@@ -808,12 +801,17 @@ namespace lacerta::cut
   Cutter::forget_applied_crossings()
   {
     for (const std::uint64_t key : applied_crossings)
-    {
-      crossings.erase(key);
-      --crossings_at[edge_end(key, 0)];
-      --crossings_at[edge_end(key, 1)];
-    }
+      forget_crossing(crossings.find(key));
     applied_crossings.clear();
+  }
+
+
+  std::unordered_map<std::uint64_t, Cutter::Crossing>::iterator
+  Cutter::forget_crossing(const std::unordered_map<std::uint64_t, Crossing>::iterator it)
+  {
+    --crossings_at[edge_end(it->first, 0)];
+    --crossings_at[edge_end(it->first, 1)];
+    return crossings.erase(it);
   }
 
 
@@ -936,35 +934,26 @@ namespace lacerta::cut
               if (es.point_stamp != merge_stamp)
               {
                 es.point_stamp = merge_stamp;
-                es.point       = {
-                        {mesh::invalid_index, mesh::invalid_index, mesh::invalid_index}};
+                es.point       = mesh::invalid_index;
               }
               // One point per edge: its copies, where the crack opens, are decided
               // with the vertices on the cut (below).
-              slot = &es.point[1];
+              slot = &es.point;
               break;
             }
             case NodeKind::face_point:
-            {
-              FaceScratch &fs = face_scratch[4 * parent + n.index];
-              if (fs.point_stamp != merge_stamp)
-              {
-                fs.point_stamp = merge_stamp;
-                fs.point       = mesh::invalid_index;
-              }
-              slot = &fs.point;
-              break;
-            }
+              // The cutter's cuts have no crack front inside a cell.
+              AssertThrow(false, dealii::ExcInternalError());
+              DEAL_II_FALLTHROUGH;
             default:
               slot = &interior;
               break;
           }
           if (*slot == mesh::invalid_index)
           {
-            const Point p = n.kind == NodeKind::edge_point   ? r.edge_points[n.index]
-                            : n.kind == NodeKind::face_point ? r.face_points[n.index]
-                                                             : r.interior_point;
-            *slot         = new_particle(p, parent);
+            const Point p =
+              n.kind == NodeKind::edge_point ? r.edge_points[n.index] : r.interior_point;
+            *slot = new_particle(p, parent);
             if (record)
             {
               CutRecord::NewPoint point{*slot, n.kind, {}, p};
@@ -981,18 +970,6 @@ namespace lacerta::cut
                   point.ids[m] = static_cast<unsigned int>(key.ids[m]);
               }
               record->new_points.push_back(point);
-            }
-            if (n.kind == NodeKind::face_point)
-            {
-              // The same point for the cell across the face.
-              const unsigned int nb = mesh.neighbor(parent, n.index);
-              if (nb != mesh::invalid_index)
-                for (unsigned int g = 0; g < 4; ++g)
-                  if (mesh.neighbor(nb, g) == parent)
-                  {
-                    face_scratch[4 * nb + g].point_stamp = merge_stamp;
-                    face_scratch[4 * nb + g].point       = *slot;
-                  }
             }
             if (n.kind != NodeKind::interior_point)
             {

@@ -182,9 +182,6 @@ namespace lacerta::cut
       std::int8_t side = 0;
       /// Whether the sweep being applied cuts the edge.
       bool applied = false;
-      /// When decided: the distances of the ends from the surface's plane, in edge
-      /// lengths (for the snapping).
-      std::array<double, 2> distance{};
     };
     /**
      * What the crossings decided so far make of one cell: the crossed local edges and
@@ -210,31 +207,11 @@ namespace lacerta::cut
     {
       return static_cast<unsigned int>(i == 0 ? key >> 32 : key & 0xFFFFFFFFu);
     }
-    /// Per-edge scratch: crossing, cut parameter, and the new particles on the edge
-    /// (one per side -1, 0, +1) while children are made. Ordered for 32 bytes: two
-    /// edges per cache line (the analysis reads it at random edge ids).
+    /// Per-edge scratch: whether the sweep tested the edge (stamp), and its cut point's
+    /// particle while children are made (valid where point_stamp is current).
     struct EdgeScratch
     {
-      unsigned int                stamp = 0, point_stamp = 0;
-      std::array<unsigned int, 3> point{};
-    };
-
-    /// Per-face-slot (4 t + f) scratch: the front point (an index into `front_rest`)
-    /// and its particle. Small (16 bytes, a cell's four faces in one cache line): the
-    /// analysis visits every face of the affected cells and few have a front point.
-    struct FaceScratch
-    {
-      /// `front` of a face without a front point.
-      static constexpr unsigned int no_front = std::numeric_limits<unsigned int>::max();
-
-      unsigned int stamp = 0, point_stamp = 0, point = 0, front = no_front;
-
-      /// Whether the face has a front point in this pass of the analysis.
-      bool
-      has_front() const
-      {
-        return front != no_front;
-      }
+      unsigned int stamp = 0, point_stamp = 0, point = 0;
     };
 
     /// One sweep of the blade from @p from to @p to: crossings, cells, split, update.
@@ -264,11 +241,14 @@ namespace lacerta::cut
     record_crossings(const std::array<std::array<Point, 3>, 2> &swept_triangles);
     /// How the edge from @p a to @p b (a < b) crosses the swept triangles, whose unit
     /// normal is @p normal, exactly.
+    /// Also the ends' distances from the surface's plane, in edge lengths, into
+    /// @p distance (for the snapping).
     Crossing
     edge_crossing(unsigned int                               a,
                   unsigned int                               b,
                   const std::array<std::array<Point, 3>, 2> &swept_triangles,
-                  const Point                               &normal) const;
+                  const Point                               &normal,
+                  std::array<double, 2>                     &distance) const;
     /// The side vertex @p v was given for the part of the surface with unit normal
     /// @p normal in this stroke, or 0.
     std::int8_t
@@ -300,6 +280,9 @@ namespace lacerta::cut
     /// Removes the crossings the sweep applies (their edges are split).
     void
     forget_applied_crossings();
+    /// Removes the crossing at @p it; returns the next one.
+    std::unordered_map<std::uint64_t, Crossing>::iterator
+    forget_crossing(std::unordered_map<std::uint64_t, Crossing>::iterator it);
     /// Replaces `removed` by the children of `results`, copies the vertices on the
     /// cut, updates masses, springs and the active set.
     void
@@ -365,7 +348,6 @@ namespace lacerta::cut
     std::vector<unsigned int> adopted;
     // Scratch, kept between sweeps so that no sweep allocates or clears O(mesh).
     std::vector<EdgeScratch> edge_scratch;
-    std::vector<FaceScratch> face_scratch;
     /// Per cell: in `affected` (stamp), and in the star of a vertex whose copies are
     /// decided again. Per vertex: its copies are decided in this sweep (stamp).
     std::vector<unsigned int> tet_mark, separate_mark;
