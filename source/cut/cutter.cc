@@ -875,7 +875,8 @@ namespace lacerta::cut
     CutRecord *record = recorder ? &recorder->emplace_back() : nullptr;
     if (record)
     {
-      record->cuts = cuts;
+      record->cuts          = cuts;
+      record->snap_fraction = parameters.snap_fraction;
       child_origin.clear();
     }
     const auto new_particle = [&](const Point &rest, const unsigned int parent)

@@ -11,16 +11,13 @@
 
 #include "cut_split_support.h"
 #include "physics_test_support.h"
-#include <map>
 #include <set>
-#include <tuple>
 
 namespace lacerta
 {
   namespace
   {
     using cut::Blade;
-    using cut::NodeKind;
     using mesh::Tet;
 
     Tet
@@ -62,20 +59,15 @@ namespace lacerta
       for (const Tet &t : original.get_tets())
         current.insert(sorted(t));
       unsigned int n_vertices = original.n_vertices();
-      using Key               = std::tuple<NodeKind, int, std::array<unsigned int, 4>>;
       for (const auto &record : records)
       {
-        std::map<Key, unsigned int>                         point_of;
-        std::map<std::array<unsigned int, 3>, unsigned int> choice;
         for (const auto &p : record.new_points)
         {
           ASSERT_EQ(p.id, n_vertices++);
           EXPECT_EQ(p.position, m.vertex(p.id));
-          if (p.kind != NodeKind::vertex)
-            point_of[{p.kind, 0, p.ids}] = p.id;
         }
-        for (const auto &c : record.vertex_choices)
-          choice[{{c.cut, c.child, c.node}}] = c.used;
+        const auto children = cut::recorded_children(record);
+        ASSERT_EQ(children.size(), record.cuts.size());
         for (unsigned int k = 0; k < record.cuts.size(); ++k)
         {
           const cut::TetCut &c = record.cuts[k];
@@ -86,51 +78,8 @@ namespace lacerta
             EXPECT_EQ(c.points[i], m.vertex(t[i]));
           }
           ASSERT_EQ(current.erase(sorted(t)), 1u) << "a recorded tet is not in the mesh";
-          cut::SplitResult r;
-          cut::split_tetrahedron(c, r);
-          for (unsigned int i = 0; i < r.n_children; ++i)
-          {
-            Tet child;
-            for (unsigned int j = 0; j < 4; ++j)
-            {
-              const cut::NodeRef         &n = r.children[i].nodes[j];
-              std::array<unsigned int, 4> ids{};
-              if (n.kind == NodeKind::vertex)
-              {
-                child[j]      = t[n.index];
-                const auto it = choice.find({{k, i, j}});
-                if (c.vertex_side[n.index] == 0 && it != choice.end())
-                  child[j] = it->second;
-                continue;
-              }
-              if (n.kind == NodeKind::edge_point)
-                ids = {{t[cut::tet_edge_vertices[n.index][0]],
-                        t[cut::tet_edge_vertices[n.index][1]],
-                        0,
-                        0}};
-              else if (n.kind == NodeKind::face_point)
-              {
-                for (unsigned int k = 0, l = 0; k < 4; ++k)
-                  if (k != n.index)
-                    ids[l++] = t[k];
-              }
-              else
-                ids = t;
-              const unsigned int count = n.kind == NodeKind::edge_point   ? 2
-                                         : n.kind == NodeKind::face_point ? 3
-                                                                          : 4;
-              std::sort(ids.begin(), ids.begin() + count);
-              // One particle per edge or face; where the crack opens, the copy of it
-              // a child uses is recorded like a vertex's.
-              const auto it = point_of.find({n.kind, 0, ids});
-              ASSERT_NE(it, point_of.end()) << "a child's point has no recorded particle";
-              child[j]          = it->second;
-              const auto chosen = choice.find({{k, i, j}});
-              if (chosen != choice.end())
-                child[j] = chosen->second;
-            }
+          for (const Tet &child : children[k])
             current.insert(sorted(child));
-          }
         }
       }
       EXPECT_EQ(n_vertices, m.n_vertices());

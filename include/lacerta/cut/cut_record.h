@@ -7,6 +7,7 @@
 #pragma once
 
 #include <lacerta/cut/split_table.h>
+#include <lacerta/mesh/tet_mesh.h>
 
 #include <array>
 #include <cstdint>
@@ -61,9 +62,22 @@ namespace lacerta::cut
 
     /// The cut of every tetrahedron the sweep replaced (vertex ids of the cut mesh).
     std::vector<TetCut> cuts;
+    /// The snap fraction the cutter split them with (split_tetrahedron()).
+    double snap_fraction = default_snap_fraction;
     /// The particles created, in creation order (increasing ids).
     std::vector<NewPoint> new_points;
     /// The vertex every child uses at each of its nodes on the cut.
     std::vector<VertexChoice> vertex_choices;
   };
+
+  /**
+   * The children the cutter made of every tetrahedron @p record replaced, in the cut
+   * mesh's vertex ids: entry k lists those of `record.cuts[k]`, in the table's order.
+   * They follow from the record alone (the table's split of each TetCut, with the
+   * recorded particle of every new point and the recorded copy of every point on the
+   * cut), so replaying the records of a stroke in order on the mesh it started from
+   * rebuilds the cut mesh exactly. Throws if a new point has no recorded particle.
+   */
+  std::vector<std::vector<mesh::Tet>>
+  recorded_children(const CutRecord &record);
 } // namespace lacerta::cut
