@@ -1,5 +1,6 @@
 // lacerta-bench mtcut: the paper's Table 2 on this machine: a stroke cuts the active
-// level of detail (TetUp) and the Multi-Triangulation is updated after it (MT-DAGUpd).
+// level of detail (TetUp) and the Multi-Triangulation is updated after it (MT-DAGUpd:
+// the cutter's records replayed and the nodes pinned, doc/mt-cutting.md).
 #include <lacerta/cut/cutter.h>
 #include <lacerta/mesh/triangulation_conversion.h>
 #include <lacerta/mt/builder.h>
@@ -61,7 +62,8 @@ namespace lacerta::bench
       const auto finest = mt::LodQueryRegistry::create_and_parse("uniform", prm);
       mt::Lod    lod(mt);
       lod.extract(*finest);
-      mesh::TetMesh mesh = lod.make_mesh(lod.active_vertices(), "level of detail");
+      std::vector<std::uint32_t> mt_vertex_of = lod.active_vertices();
+      mesh::TetMesh              mesh = lod.make_mesh(mt_vertex_of, "level of detail");
 
       const dealii::Functions::ConstantFunction<3> density(1000), youngs(5e4);
       const auto               particles = make_particle_system(mesh, density, youngs);
@@ -88,7 +90,7 @@ namespace lacerta::bench
       const auto   start = Clock::now();
       mt::MtCutter mt_cutter(mt);
       const double index  = std::chrono::duration<double>(Clock::now() - start).count();
-      const auto   update = mt_cutter.apply(records, &lod, &mesh);
+      const auto   update = mt_cutter.apply(records, mt_vertex_of, lod);
 
       std::printf("%8u %8u %6u %6u %6u %9.1f %7u %7u %11.1f %8.1f   %5u %7.0f %9.0f\n",
                   input.n_tets(),
@@ -112,6 +114,9 @@ namespace lacerta::bench
       print_figure(prefix + "mt_cut_tets", update.cut_tets, "");
       print_figure(prefix + "mt_dag_update", 1e3 * update.seconds, "ms");
       print_figure(prefix + "mt_index", 1e3 * index, "ms");
+      print_figure(prefix + "pinned_nodes",
+                   update.pinned_applied + update.pinned_undone,
+                   "");
     }
 
 
@@ -126,7 +131,8 @@ namespace lacerta::bench
         "Table 2: one cut across a slab, full-resolution level of detail; "
         "SF split fragments, CuT/CrT tetrahedra cut/created in the level of "
         "detail by the cutter (TetUp: its update, ms) and in the MT (MT-DAGUpd, "
-        "ms; the MT's grid index is built once, before)\n");
+        "ms: the records replayed and the nodes pinned; the MT's vertex index is "
+        "built once, before)\n");
       std::printf("%8s %8s %6s %6s %6s %9s %7s %7s %11s %8s | %5s %7s %9s\n",
                   "mesh",
                   "nodes",

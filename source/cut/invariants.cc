@@ -29,7 +29,8 @@ namespace lacerta::cut
                                 x[c[e[1]]][2] - x[c[e[0]]][2]));
       if (!(mesh.volume(t) > 1e-9 * h * h * h))
       {
-        problem << "tetrahedron " << t << " is inverted or flat (volume "
+        problem << "tetrahedron " << t << " (vertices " << c[0] << ", " << c[1] << ", "
+                << c[2] << ", " << c[3] << ") is inverted or flat (volume "
                 << mesh.volume(t) << ", longest edge " << h << ")";
         return problem.str();
       }

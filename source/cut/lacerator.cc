@@ -228,10 +228,9 @@ namespace lacerta::cut
     surface_valid = false;
     for (Laceration &l : lacerations)
       l.cutter.reset();
-    // The particles the lacerations created, found again by their rest positions: the
-    // MT's version of a torn level (and any later level) puts its own vertices on the
-    // rest tear surface, within about one element of those the lacerations' cutters
-    // created. O(particles created by cuts x particles created by lacerations).
+    // The particles the lacerations created, found again by their rest positions among
+    // those cuts created (a new level of detail numbers its particles anew).
+    // O(particles created by cuts x particles created by lacerations).
     sheet.assign(system.n_particles(), no_laceration);
     for (unsigned int v = 0; v < system.n_particles(); ++v)
       if (created_by_cut[v])

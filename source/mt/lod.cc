@@ -154,6 +154,15 @@ namespace lacerta::mt
   Lod::evaluate_own(const std::uint32_t j, const LodQuery &query)
   {
     need_stamp[j] = stamp;
+    // A node a cut pinned (MultiTriangulation::cut_pin) keeps its state for good, and
+    // so decides for its descendants: those of a node pinned undone cannot be applied,
+    // those of a node pinned applied are free.
+    if (const int pin = mt->pin(j); pin != 0)
+    {
+      need_value[j] = pin > 0;
+      need_until[j] = std::numeric_limits<double>::infinity();
+      return true;
+    }
     // The bounds: neither j nor a descendant can fail where the query allows error[j]
     // over ball[j].
     const auto &b = mt->ball[j];
@@ -269,9 +278,10 @@ namespace lacerta::mt
     // slack the focus has travelled past (the others keep their need: they stay).
     std::vector<std::uint32_t> candidates;
     travel = query.focus_travel();
-    if (query.identity() != query_identity)
+    if (query.identity() != query_identity || mt->n_cut_updates != cut_updates_seen)
     {
-      query_identity = query.identity();
+      query_identity   = query.identity();
+      cut_updates_seen = mt->n_cut_updates;
       std::fill(need_until.begin(),
                 need_until.end(),
                 -std::numeric_limits<double>::infinity());
@@ -413,26 +423,8 @@ namespace lacerta::mt
         best_coordinates = b;
       }
     };
-    std::uint32_t     j         = mt->vertex_node[v];
-    const std::size_t first_cut = mt->first_cut_vertex();
-    if (v >= first_cut)
-    {
-      // A vertex a cut created: it can come in with any node whose fragments contain
-      // it, applied or undone. Start from the node that inserts the tet whose split
-      // created it; if that node was applied, walk down through the destroyers of the
-      // tets containing p until one was not applied (that tet was active).
-      j = mt->creator[mt->cut_origin[v - first_cut]];
-      if (was_applied(j))
-        while (true)
-        {
-          best_minimum = -1e300;
-          mt->for_each_fine(j, consider);
-          const std::uint32_t child = mt->destroyer[best];
-          if (child == mesh::invalid_index || !was_applied(child))
-            return {best, best_coordinates};
-          j = child;
-        }
-    }
+    // A vertex a cut created is never brought in: the cut's nodes are pinned.
+    std::uint32_t j = mt->vertex_node[v];
     while (true)
     {
       // The coarse tets of j (which the collapse of its vertex created) tile its star.

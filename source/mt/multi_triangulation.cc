@@ -12,7 +12,7 @@ namespace lacerta::mt
               + coarse_begin.capacity() + coarse_list.capacity() + node_vertex.capacity()
               + vertex_node.capacity())
                * sizeof(std::uint32_t)
-           + replaced.capacity()
+           + replaced.capacity() + cut_pin.capacity()
            + (error.capacity() + own_error.capacity()) * sizeof(double)
            + (ball.capacity() + own_ball.capacity()) * sizeof(std::array<double, 4>);
   }
@@ -46,7 +46,8 @@ namespace lacerta::mt
         || coarse_begin.front() != 0 || coarse_begin.back() != coarse_list.size()
         || (!cut_fine.empty() && (cut_fine.size() != n || cut_coarse.size() != n))
         || (!replaced.empty() && replaced.size() != tets.size())
-        || cut_origin.size() > vertices.size())
+        || cut_origin.size() > vertices.size()
+        || (!cut_pin.empty() && cut_pin.size() != n))
       throw_error("Multi-Triangulation '", source, "': inconsistent array sizes.");
     for (std::size_t j = 0; j < n; ++j)
     {

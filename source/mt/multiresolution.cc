@@ -2,7 +2,6 @@
 #include <lacerta/base/parameter_utilities.h>
 #include <lacerta/base/parsed_function.h>
 #include <lacerta/cut/tool.h>
-#include <lacerta/mt/cut_state_transfer.h>
 #include <lacerta/mt/multiresolution.h>
 
 #include <deal.II/base/function_parser.h>
@@ -115,7 +114,6 @@ namespace lacerta::mt
     parameters.boundary_error_weight  = prm.get_double("Boundary error weight");
     prm.leave_subsection();
     prm.leave_subsection();
-    boundary_error = parameters.maximum_boundary_error;
 
     for (const mesh::Point3 &x : input.get_vertices())
       box.extend(x);
@@ -238,13 +236,20 @@ namespace lacerta::mt
 
 
   MtCutter::Statistics
-  Multiresolution::apply_cut(const std::vector<cut::CutRecord> &records,
-                             const double                       snap_fraction)
+  Multiresolution::apply_cut(const std::vector<cut::CutRecord> &records)
   {
     if (!mt_cutter)
-      mt_cutter = std::make_unique<MtCutter>(mt, snap_fraction, boundary_error);
-    const MtCutter::Statistics statistics = mt_cutter->apply(records, lod.get(), &mesh);
-    make_active_mesh();
+      mt_cutter = std::make_unique<MtCutter>(mt);
+    // The cut mesh stays: replayed, the records make the level of detail this mesh.
+    // The MT ids of its new particles are appended in their order, after every id the
+    // MT had, so the list stays increasing.
+    const MtCutter::Statistics statistics = mt_cutter->apply(records, vertices, *lod);
+    if (vertices.size() != mesh.n_vertices())
+      throw_error("Multiresolution: internal error, the MT knows ",
+                  vertices.size(),
+                  " of the cut mesh's ",
+                  mesh.n_vertices(),
+                  " vertices.");
     return statistics;
   }
 
@@ -253,9 +258,7 @@ namespace lacerta::mt
   Multiresolution::make_active_mesh()
   {
     vertices = lod->active_vertices();
-    if (mt_cutter)
-      previous = std::move(mesh);
-    mesh = lod->make_mesh(vertices, "level of detail");
+    mesh     = lod->make_mesh(vertices, "level of detail");
   }
 
 
@@ -274,13 +277,6 @@ namespace lacerta::mt
                : static_cast<std::size_t>(-1);
     };
     n_kept = n_new = 0;
-    // A cut MT: the walk of locate_in_previous() may end in a tetrahedron across the
-    // opened cut, and each level's cut surface is snapped differently, so new vertices
-    // are interpolated geometrically in the previous level's piece that holds their
-    // tetrahedra. Kept vertices keep their own state below: their MT id is exact, also
-    // on the cut, where copies share a position and only the id tells the sides apart.
-    if (mt_cutter)
-      n_new = transfer_state_across_cut(previous, old_x, old_v, mesh, x, v).interpolated;
     for (std::size_t i = 0; i < vertices.size(); ++i)
     {
       const std::size_t o = old_index(vertices[i]);
@@ -294,8 +290,6 @@ namespace lacerta::mt
         }
         continue;
       }
-      if (mt_cutter)
-        continue; // a copy of a particle at its position, or counted as interpolated
       ++n_new;
       auto [tet, lambda] = lod->locate_in_previous(vertices[i]);
       double sum         = 0;

@@ -44,6 +44,8 @@ namespace lacerta::postprocess
         scene = &s;
         s.system_changed.connect([this](const scene::SystemChange &change)
                                  { report(change); });
+        s.multi_triangulation_cut.connect([this](const scene::MultiresolutionCut &mt_cut)
+                                          { report_multiresolution_cut(mt_cut); });
       }
 
       void
@@ -94,8 +96,6 @@ namespace lacerta::postprocess
           stroke.update_seconds += change.tear->update_seconds;
           report_tear(change.time, *change.tear);
         }
-        if (change.mt_cut)
-          report_multiresolution_cut(change.time, *change.mt_cut);
       }
 
       void
@@ -120,8 +120,7 @@ namespace lacerta::postprocess
       }
 
       void
-      report_multiresolution_cut(const double                     time,
-                                 const scene::MultiresolutionCut &mt_cut)
+      report_multiresolution_cut(const scene::MultiresolutionCut &mt_cut)
       {
         ++table2.updates;
         table2.split_fragments += mt_cut.update.split_fragments;
@@ -129,7 +128,7 @@ namespace lacerta::postprocess
         table2.created += mt_cut.update.created_tets;
         table2.tet_update_seconds += stroke.update_seconds;
         table2.mt_update_seconds += mt_cut.update.seconds;
-        std::cout << "MT update after the stroke at t = " << time << " s: SF "
+        std::cout << "MT update after the stroke at t = " << mt_cut.time << " s: SF "
                   << mt_cut.update.split_fragments << ", CuT " << stroke.cut << ", CrT "
                   << stroke.created;
         if (!test_mode)
@@ -137,12 +136,11 @@ namespace lacerta::postprocess
                     << 1e3 * mt_cut.update.seconds << " ms";
         std::cout << "; MT tetrahedra cut " << mt_cut.update.cut_tets << ", created "
                   << mt_cut.update.created_tets << ", vertices added "
-                  << mt_cut.update.new_vertices << "; level of detail " << mt_cut.n_tets
-                  << " tetrahedra, " << mt_cut.n_particles << " particles ("
-                  << mt_cut.transfer.copied << " copied, " << mt_cut.transfer.interpolated
-                  << " interpolated), mass " << mt_cut.mass << " kg; mesh components "
-                  << mt_cut.pieces_after << " (the cutter's mesh had "
-                  << mt_cut.pieces_before << ")\n";
+                  << mt_cut.update.new_vertices << ", nodes pinned "
+                  << mt_cut.update.pinned_applied << " applied and "
+                  << mt_cut.update.pinned_undone << " undone; level of detail "
+                  << mt_cut.n_tets << " tetrahedra, " << mt_cut.n_particles
+                  << " particles, mesh components " << mt_cut.pieces << "\n";
         stroke = {};
       }
 

@@ -220,28 +220,13 @@ namespace lacerta::scene
         || (cutter && !cutter->active_tets().empty()))
       return std::nullopt;
     MultiresolutionCut result;
-    result.pieces_before = cut::count_components(multiresolution->active_mesh());
-    result.update =
-      multiresolution->apply_cut(cut_records, cutter_parameters.snap_fraction);
+    result.update = multiresolution->apply_cut(cut_records);
     cut_records.clear();
-    // The cutter's mesh, which the MT's version of it replaced.
-    const mesh::TetMesh &cut_mesh = multiresolution->previous_mesh();
-    move_to_level_of_detail(t,
-                            [&](const std::vector<double> &old_x,
-                                const std::vector<double> &old_v,
-                                std::vector<double>       &x,
-                                std::vector<double>       &v)
-                            {
-                              result.transfer = mt::transfer_state_across_cut(
-                                cut_mesh, old_x, old_v, active_mesh(), x, v);
-                            });
-    result.pieces_after = cut::count_components(active_mesh());
-    result.n_tets       = active_mesh().n_tets();
-    result.n_particles  = system->n_particles();
-    result.mass         = std::accumulate(system->mass.begin(), system->mass.end(), 0.0);
-    SystemChange change{SystemChange::Cause::multiresolution_cut, t};
-    change.mt_cut = &result;
-    system_changed(change);
+    result.n_tets      = active_mesh().n_tets();
+    result.n_particles = system->n_particles();
+    result.pieces      = cut::count_components(active_mesh());
+    result.time        = t;
+    multi_triangulation_cut(result);
     return result;
   }
 
@@ -405,8 +390,6 @@ namespace lacerta::scene
         return "the cut";
       case Cause::laceration:
         return "the laceration";
-      case Cause::multiresolution_cut:
-        return "the MT update after the stroke";
       case Cause::level_of_detail:
         return "the re-extraction of the level of detail";
     }

@@ -135,8 +135,8 @@ namespace lacerta::cut
 
     /**
      * Tells the lacerator that the particle system now lives on another mesh (the
-     * object it was built with, refilled: the MT's version of the torn level of detail,
-     * or a re-extraction), so particle numbers changed. The surface springs are
+     * object it was built with, refilled by a re-extraction of the level of detail), so
+     * particle numbers changed. The surface springs are
      * collected again; the cutters of lacerations that stopped inside are dropped (a
      * continuation builds a new one at the tip, on the new mesh); a particle flagged in
      * @p created_by_cut (one entry per particle) is again one a laceration created if it

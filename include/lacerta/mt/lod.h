@@ -29,6 +29,8 @@ namespace lacerta::mt
    * refines every failing fragment. The same set comes out whether it is extracted
    * from the root or updated from any previous level of detail. The search of the
    * descendants is cut short by the monotone bounds (error, ball) of the MT.
+   * Nodes a cut pinned (MultiTriangulation::cut_pin) are needed or not whatever the
+   * query, so every extraction keeps the cut tetrahedra.
    */
   class Lod
   {
@@ -102,9 +104,10 @@ namespace lacerta::mt
     follow_cut(std::uint32_t parent, const std::vector<std::uint32_t> &children);
 
     /**
-     * For a vertex @p v that the last extract() brought in, the tetrahedron of the
-     * previous level of detail that contains its rest position, found by walking up
-     * the MT from the fragment that removed it (Section 4.2), and v's barycentric
+     * For a vertex @p v that the last extract() brought in (never one a cut created:
+     * the cut's nodes are pinned), the tetrahedron of the previous level of detail
+     * that contains its rest position, found by walking up the MT from the fragment
+     * that removed it (Section 4.2), and v's barycentric
      * coordinates in it (not clamped: slightly negative ones mean that v lies outside
      * the previous, coarser boundary).
      */
@@ -201,8 +204,10 @@ namespace lacerta::mt
     std::vector<std::pair<double, std::uint32_t>> checks;
     std::vector<double>                           check_at;
     std::uint64_t                                 query_identity = 0;
-    std::uint32_t                                 stamp          = 0;
-    unsigned int                                  n_last_applied = 0;
-    unsigned int                                  n_last_undone  = 0;
+    /// MultiTriangulation::n_cut_updates at the last extraction.
+    unsigned int  cut_updates_seen = 0;
+    std::uint32_t stamp            = 0;
+    unsigned int  n_last_applied   = 0;
+    unsigned int  n_last_undone    = 0;
   };
 } // namespace lacerta::mt

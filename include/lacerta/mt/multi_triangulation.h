@@ -28,8 +28,10 @@ namespace lacerta::mt
    *
    * Vertices are those of the input mesh with their ids: decimation removes vertices and
    * never invents any, so particles keep their vertex id at every level of detail. A
-   * cut (mt/mt_cutter.h) replaces the tetrahedra it crosses by their children, which
-   * keep their parent's creator and destroyer, and appends the vertices it creates.
+   * cut (mt/mt_cutter.h) replaces the tetrahedra of the level of detail it cut by
+   * their children, which keep their parent's creator and destroyer, appends the
+   * vertices it creates, and pins the nodes (cut_pin) so that every later extraction
+   * keeps those children.
    */
   class MultiTriangulation
   {
@@ -77,10 +79,19 @@ namespace lacerta::mt
     std::vector<std::uint8_t> replaced;
     /**
      * For the vertices cuts created, the last cut_origin.size() ones: the tet whose
-     * split created each (a level of detail that brings the vertex in finds the
-     * previous level's tet around it from there). Empty until the first cut.
+     * split created each. Empty until the first cut.
      */
     std::vector<std::uint32_t> cut_origin;
+    /**
+     * Per node, what cuts require of it (mt/mt_cutter.h): +1 it must be applied (it or
+     * a descendant inserts a cut tetrahedron), -1 it must not be (it or an ancestor
+     * removes one), 0 free. Only the levels of detail that were cut are split, so
+     * every extraction keeps them where the cuts passed. Empty until the first cut.
+     */
+    std::vector<std::int8_t> cut_pin;
+    /// The number of cuts applied to the MT: a level of detail re-tests every node
+    /// after one (pins may have changed).
+    unsigned int n_cut_updates = 0;
     /**
      * Per node: its own error, the average volume of its coarse fragment alone (0 for
      * the root). A tetrahedron satisfies a query when the node that removes it has an
@@ -161,6 +172,13 @@ namespace lacerta::mt
       else
         for (const std::uint32_t t : cut_coarse[j])
           f(t);
+    }
+
+    /// What cuts require of node @p j: +1 applied, -1 not applied, 0 nothing.
+    int
+    pin(const unsigned int j) const
+    {
+      return cut_pin.empty() ? 0 : cut_pin[j];
     }
 
     /// Whether tet @p t belongs to the MT (a cut has not replaced it).

@@ -84,7 +84,7 @@ namespace lacerta::mt
     /**
      * The mesh of the current level of detail, for the Cutter to cut in place. Once
      * cut, its new particles have no MT vertex id (active_vertices() lists the first
-     * ones only) until apply_cut() replaces it; update() must not be called between.
+     * ones only) until apply_cut() records them; update() must not be called between.
      */
     mesh::TetMesh &
     mesh_to_cut()
@@ -93,24 +93,14 @@ namespace lacerta::mt
     }
 
     /**
-     * Splits the MT along the rest cut surface of @p records (made by a Cutter on
-     * mesh_to_cut(), in order, snapping with @p snap_fraction) and makes the level of
-     * detail the MT's version of the cut one (doc/mt-cutting.md); active_mesh() is then
-     * rebuilt from it. The index of the MT's tetrahedra is built at the first call.
-     * Returns the MT columns of the paper's Table 2.
+     * Replays @p records (made by a Cutter on mesh_to_cut(), in order) on the MT
+     * (MtCutter): the level of detail's MT version is then the cut mesh itself, which
+     * stays the active mesh, its new particles with MT vertex ids, and every later
+     * extraction keeps the cut (doc/mt-cutting.md). The MT's vertex index is built at
+     * the first call. Returns the MT columns of the paper's Table 2.
      */
     MtCutter::Statistics
-    apply_cut(const std::vector<cut::CutRecord> &records, double snap_fraction);
-
-    /**
-     * The level of detail before the last change, once the MT has been cut (after
-     * apply_cut(): the mesh the cutter cut); empty before the first cut.
-     */
-    const mesh::TetMesh &
-    previous_mesh() const
-    {
-      return previous;
-    }
+    apply_cut(const std::vector<cut::CutRecord> &records);
 
     /// The MT vertex id of every vertex of active_mesh(), increasing.
     const std::vector<std::uint32_t> &
@@ -125,9 +115,7 @@ namespace lacerta::mt
      * @p old_vertices: vertices kept keep their state, new ones get the state
      * interpolated in the previous level's tetrahedron that contains them
      * (Lod::locate_in_previous), with barycentric coordinates clamped to the
-     * tetrahedron. Once the MT has been cut, new vertices are located geometrically in
-     * the previous level's tetrahedron on their side of the cut
-     * (transfer_state_across_cut()).
+     * tetrahedron.
      */
     void
     transfer_state(const std::vector<std::uint32_t> &old_vertices,
@@ -184,17 +172,12 @@ namespace lacerta::mt
     /// `Focus follows = tool`: the focus follows the blade, not the path.
     bool follows_tool = false;
     /// The bounding box of the mesh at rest.
-    cut::Box     box;
-    double       distance = 0;
-    unsigned int interval = 1;
-    /// The builder's `Maximum boundary error`, which the MT's cuts must reach past.
-    double        boundary_error = 0.01;
-    mesh::Point3  last_focus{};
-    unsigned int  last_step = 0;
-    mesh::TetMesh mesh;
-    /// The level of detail before the last change, kept once the MT has been cut
-    /// (mt_cutter exists): transfer_state() then carries state geometrically.
-    mesh::TetMesh              previous;
+    cut::Box                   box;
+    double                     distance = 0;
+    unsigned int               interval = 1;
+    mesh::Point3               last_focus{};
+    unsigned int               last_step = 0;
+    mesh::TetMesh              mesh;
     std::vector<std::uint32_t> vertices;
     std::size_t                n_kept = 0, n_new = 0;
   };

@@ -7,7 +7,6 @@
 #include <lacerta/base/signal.h>
 #include <lacerta/cut/cutter.h>
 #include <lacerta/mesh/tet_mesh.h>
-#include <lacerta/mt/cut_state_transfer.h>
 #include <lacerta/mt/mt_cutter.h>
 #include <lacerta/scene/body_force.h>
 #include <lacerta/scene/constraint.h>
@@ -43,14 +42,10 @@ namespace lacerta::scene
   {
     /// The MT update (SF, MT tetrahedra cut and created, MT-DAGUpd).
     mt::MtCutter::Statistics update;
-    /// How the particles' state reached the MT's version of the cut level of detail.
-    mt::CutTransferReport transfer;
-    /// Connected pieces of the cutter's mesh before the switch and of the MT's
-    /// version after it (they differ where the MT update left a bridge).
-    unsigned int pieces_before = 0, pieces_after = 0;
-    /// The level of detail the system moved to: tetrahedra, particles and mass (kg).
-    unsigned int n_tets = 0, n_particles = 0;
-    double       mass = 0;
+    /// The level of detail, which is the cutter's mesh: tetrahedra, particles, pieces.
+    unsigned int n_tets = 0, n_particles = 0, pieces = 0;
+    /// Simulated time of the update (s).
+    double time = 0;
   };
 
 
@@ -84,14 +79,20 @@ namespace lacerta::scene
     ~Scene();
 
     /**
-     * Emitted after every change of the particle system (a cut, a tear, the MT update
-     * after a stroke, a new level of detail), once the scene has followed it itself:
+     * Emitted after every change of the particle system (a cut, a tear, a new level of
+     * detail), once the scene has followed it itself:
      * the constraints take over the copies of their particles, the cutter restarts on
      * a new mesh, the lacerator learns what changed. Subscribers (the simulator's
      * integrator and stability control, a viewer) connect to it; the scene's own
      * reaction is connected first.
      */
     Signal<const SystemChange &> system_changed;
+
+    /**
+     * Emitted after the MT was updated with a stroke's or a tear's records
+     * (update_multiresolution_after_cut()). The particle system does not change.
+     */
+    Signal<const MultiresolutionCut &> multi_triangulation_cut;
 
     /**
      * Moves the scalpel's blade to @p blade (cut::Cutter::move_blade()) on the state at
@@ -123,11 +124,10 @@ namespace lacerta::scene
     /**
      * With multiresolution: once the scalpel's stroke is over (its blade is in no
      * tetrahedron, or there is no scalpel) and the scalpel or a tear has cut the level
-     * of detail since the last call, updates the MT with their records, rebuilds the
-     * particle system on the MT's version of the cut level of detail at time @p t (state
-     * carried over by mt::transfer_state_across_cut(), masses scaled to ∫σ, constraints
-     * applied to the particles in their regions) and emits system_changed. Returns what
-     * it did, or nothing if there was nothing to do.
+     * of detail since the last call, replays their records on the MT (the level of
+     * detail stays the cut mesh; later extractions keep the cut) and emits
+     * multi_triangulation_cut at time @p t. Returns what it did, or nothing if there was
+     * nothing to do.
      */
     std::optional<MultiresolutionCut>
     update_multiresolution_after_cut(double t);

@@ -17,8 +17,6 @@ namespace lacerta::cut
 
 namespace lacerta::scene
 {
-  struct MultiresolutionCut;
-
   /**
    * A change of the particle system's topology: its particles, springs or masses are
    * others than before. Scene::system_changed carries it to every subscriber.
@@ -32,8 +30,6 @@ namespace lacerta::scene
       cut,
       /// A tear cut the mesh locally.
       laceration,
-      /// The system moved to the MT's version of the cut level of detail.
-      multiresolution_cut,
       /// The system moved to a newly extracted level of detail.
       level_of_detail
     };
@@ -43,12 +39,10 @@ namespace lacerta::scene
     double time = 0;
     /**
      * What the change did: the blade motion's statistics for a cut, the tear's for a
-     * laceration, the MT update's for a multiresolution cut; nullptr otherwise. Valid
-     * during the event only.
+     * laceration; nullptr otherwise. Valid during the event only.
      */
-    const cut::CutStepStatistics    *cut    = nullptr;
-    const cut::LacerationStatistics *tear   = nullptr;
-    const MultiresolutionCut        *mt_cut = nullptr;
+    const cut::CutStepStatistics    *cut  = nullptr;
+    const cut::LacerationStatistics *tear = nullptr;
 
     /// Particles a local cut or tear duplicated along its surface, as (original, copy)
     /// (cut::CutStepStatistics::copied_particles); empty after a reassembly.
@@ -60,7 +54,7 @@ namespace lacerta::scene
     bool
     reassembled() const
     {
-      return cause == Cause::multiresolution_cut || cause == Cause::level_of_detail;
+      return cause == Cause::level_of_detail;
     }
 
     /// The cause in words, for messages: "the cut", "the laceration", ...
