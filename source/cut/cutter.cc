@@ -815,86 +815,75 @@ namespace lacerta::cut
   }
 
 
-  void
-  Cutter::apply(const Blade &end, CutStepStatistics &statistics)
+  Cutter::CellTerms
+  Cutter::cell_terms(const unsigned int t) const
   {
-    // Contributions of the tetrahedra that go, straight from the particles and from
-    // the springs of their edges (by edge id, before the mesh update moves the ids;
-    // a spring whose edge dies is retired with it). Every spring gets these terms
-    // first and those of the new tetrahedra after, in the order of the cells.
-    physics::SpringSet &springs = system.springs;
-    touched_vertices.clear();
-    double integral_delta = 0;
     // A constant density and Young's modulus (the common case) need no Function call
     // and one volume per cell instead of two; the masses and stiffness factors are the
     // same to the last bit.
-    struct CellTerms
+    if (constant_density_mass && constant_youngs_modulus)
     {
-      std::array<double, 4> mass;
-      double                stiffness_factor;
-    };
-    const auto cell_terms = [&](const unsigned int t) -> CellTerms
-    {
-      if (constant_density_mass && constant_youngs_modulus)
-      {
-        const double volume = mesh.volume(t);
-        return {(*constant_density_mass)(volume), *constant_youngs_modulus * volume};
-      }
-      return {constant_density_mass ? (*constant_density_mass)(mesh.volume(t))
-                                    : physics::tet_mass_contributions(mesh, t, density),
-              physics::tet_stiffness_factor(mesh, t, youngs_modulus)};
-    };
-    for (const unsigned int r : removed)
-    {
-      const CellTerms              terms = cell_terms(r);
-      const std::array<double, 4> &m     = terms.mass;
-      for (unsigned int i = 0; i < 4; ++i)
-      {
-        system.mass[mesh.tet(r)[i]] -= m[i];
-        touched_vertices.push_back(mesh.tet(r)[i]);
-        integral_delta -= m[i];
-      }
-      const double f = -terms.stiffness_factor;
-      for (const unsigned int e : mesh.tet_edges(r))
-      {
-        springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
-        changed_springs.push_back(e);
-      }
+      const double volume = mesh.volume(t);
+      return {(*constant_density_mass)(volume), *constant_youngs_modulus * volume};
     }
+    return {constant_density_mass ? (*constant_density_mass)(mesh.volume(t))
+                                  : physics::tet_mass_contributions(mesh, t, density),
+            physics::tet_stiffness_factor(mesh, t, youngs_modulus)};
+  }
 
-    lap(statistics.physics_seconds);
 
-    // New points, merged across tetrahedra through the edge and face they lie on (one
-    // particle per edge and side, per face); state interpolated from the parent (the
-    // same affine map at rest and deformed).
+  void
+  Cutter::add_cell_terms(const unsigned int t, const double sign, double &integral_delta)
+  {
+    physics::SpringSet          &springs = system.springs;
+    const CellTerms              terms   = cell_terms(t);
+    const std::array<double, 4> &m       = terms.mass;
+    for (unsigned int i = 0; i < 4; ++i)
+    {
+      system.mass[mesh.tet(t)[i]] += sign * m[i];
+      touched_vertices.push_back(mesh.tet(t)[i]);
+      integral_delta += sign * m[i];
+    }
+    const double f = sign * terms.stiffness_factor;
+    for (const unsigned int e : mesh.tet_edges(t))
+    {
+      springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
+      changed_springs.push_back(e);
+    }
+  }
+
+
+  unsigned int
+  Cutter::new_particle(const Point       &rest,
+                       const unsigned int parent,
+                       CutStepStatistics &statistics)
+  {
+    // The state interpolated from the parent: the same affine map at rest and deformed.
+    const mesh::Tet &tet = mesh.tet(parent);
+    const auto       l   = rest_barycentric(mesh, parent, rest);
+    Point            x{{0, 0, 0}}, v{{0, 0, 0}};
+    for (unsigned int i = 0; i < 4; ++i)
+      for (unsigned int c = 0; c < 3; ++c)
+      {
+        x[c] += l[i] * system.position[3 * tet[i] + c];
+        v[c] += l[i] * system.velocity[3 * tet[i] + c];
+      }
+    const unsigned int id = mesh.add_vertex(rest);
+    system.add_particle(rest, x, v);
+    ++statistics.new_particles;
+    return id;
+  }
+
+
+  void
+  Cutter::make_children(CutStepStatistics &statistics, CutRecord *record)
+  {
+    // New points, merged across tetrahedra through the edge they lie on (one particle
+    // per edge), interior points per cell; boundary ids inherited from the parent.
     ++merge_stamp;
     children.clear();
     child_cut_faces.clear();
     face_ids.clear();
-    // The record of this sweep for the Multi-Triangulation (set_recorder()).
-    CutRecord *record = recorder ? &recorder->emplace_back() : nullptr;
-    if (record)
-    {
-      record->cuts          = cuts;
-      record->snap_fraction = parameters.snap_fraction;
-      child_origin.clear();
-    }
-    const auto new_particle = [&](const Point &rest, const unsigned int parent)
-    {
-      const mesh::Tet &tet = mesh.tet(parent);
-      const auto       l   = rest_barycentric(mesh, parent, rest);
-      Point            x{{0, 0, 0}}, v{{0, 0, 0}};
-      for (unsigned int i = 0; i < 4; ++i)
-        for (unsigned int c = 0; c < 3; ++c)
-        {
-          x[c] += l[i] * system.position[3 * tet[i] + c];
-          v[c] += l[i] * system.velocity[3 * tet[i] + c];
-        }
-      const unsigned int id = mesh.add_vertex(rest);
-      system.add_particle(rest, x, v);
-      ++statistics.new_particles;
-      return id;
-    };
     for (std::size_t k = 0; k < cuts.size(); ++k)
     {
       const TetCut      &c        = cuts[k];
@@ -954,7 +943,7 @@ namespace lacerta::cut
           {
             const Point p =
               n.kind == NodeKind::edge_point ? r.edge_points[n.index] : r.interior_point;
-            *slot = new_particle(p, parent);
+            *slot = new_particle(p, parent, statistics);
             if (record)
             {
               CutRecord::NewPoint point{*slot, n.kind, {}, p};
@@ -1009,6 +998,12 @@ namespace lacerta::cut
         face_ids.push_back(fid);
       }
     }
+  }
+
+
+  void
+  Cutter::separate_points_on_cut(CutStepStatistics &statistics, CutRecord *record)
+  {
     // Vertices on the cut: one copy per group of their children connected through
     // faces not on the cut, so that the two sides separate where the crack is open
     // and stay joined at the crack tip.
@@ -1068,13 +1063,13 @@ namespace lacerta::cut
       mark_on_surface(v);
       b = e;
     }
+  }
 
-    lap(statistics.children_seconds);
 
-    // The mesh, locally.
-    mesh.replace_tets(removed, children, face_ids, added_ids, edge_update);
-    lap(statistics.mesh_seconds);
-
+  void
+  Cutter::update_springs_and_masses(double &integral_delta)
+  {
+    physics::SpringSet &springs = system.springs;
     // Springs follow the edges: appended, moved into retired slots, restiffened.
     const auto &edges = mesh.get_edges();
     for (unsigned int i = 0; i < edge_update.n_added; ++i)
@@ -1094,26 +1089,12 @@ namespace lacerta::cut
       springs.retire(to);
     }
     prepare_scratch();
-    for (std::size_t k = 0; k < added_ids.size(); ++k)
+    for (const unsigned int t : added_ids)
     {
-      const unsigned int           t     = added_ids[k];
-      const CellTerms              terms = cell_terms(t);
-      const std::array<double, 4> &m     = terms.mass;
-      for (unsigned int i = 0; i < 4; ++i)
-      {
-        system.mass[mesh.tet(t)[i]] += m[i];
-        touched_vertices.push_back(mesh.tet(t)[i]);
-        integral_delta += m[i];
-      }
-      const double f = terms.stiffness_factor;
-      for (const unsigned int e : mesh.tet_edges(t))
-      {
-        springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
-        changed_springs.push_back(e);
-      }
-      for (unsigned int f2 = 0; f2 < 4; ++f2)
-        if (mesh.neighbor(t, f2) == mesh::invalid_index)
-          tree.add_face(mesh, t, f2);
+      add_cell_terms(t, +1, integral_delta);
+      for (unsigned int f = 0; f < 4; ++f)
+        if (mesh.neighbor(t, f) == mesh::invalid_index)
+          tree.add_face(mesh, t, f);
     }
     // A vertex that lost all its cells cannot happen (copies take over whole stars),
     // but a mass that rounding left a hair below zero would be nonsense: clamp. A mass
@@ -1124,8 +1105,12 @@ namespace lacerta::cut
     for (const unsigned int v : touched_vertices)
       if (system.mass[v] < 0 && system.mass[v] > -rounding)
         system.mass[v] = 0;
-    integral_of_density += integral_delta;
+  }
 
+
+  void
+  Cutter::update_active_cells(const Blade &end)
+  {
     // The active cells: the new ones the blade is in.
     std::sort(removed.begin(), removed.end());
     active.erase(std::remove_if(active.begin(),
@@ -1152,6 +1137,41 @@ namespace lacerta::cut
       if (cell.overlaps(blade_box) && blade_in_tet(t, end))
         active.push_back(t);
     }
+  }
+
+
+  void
+  Cutter::apply(const Blade &end, CutStepStatistics &statistics)
+  {
+    // The terms of the cells that go, from the masses and from the springs of their
+    // edges (by edge id, before the mesh update moves the ids; a spring whose edge
+    // dies is retired with it). Every spring gets these terms first and those of the
+    // new cells after, in the order of the cells.
+    touched_vertices.clear();
+    double integral_delta = 0;
+    for (const unsigned int r : removed)
+      add_cell_terms(r, -1, integral_delta);
+    lap(statistics.physics_seconds);
+
+    // The record of this sweep for the Multi-Triangulation (set_recorder()).
+    CutRecord *record = recorder ? &recorder->emplace_back() : nullptr;
+    if (record)
+    {
+      record->cuts          = cuts;
+      record->snap_fraction = parameters.snap_fraction;
+      child_origin.clear();
+    }
+    make_children(statistics, record);
+    separate_points_on_cut(statistics, record);
+    lap(statistics.children_seconds);
+
+    // The mesh, locally.
+    mesh.replace_tets(removed, children, face_ids, added_ids, edge_update);
+    lap(statistics.mesh_seconds);
+
+    update_springs_and_masses(integral_delta);
+    integral_of_density += integral_delta;
+    update_active_cells(end);
     statistics.changed = true;
     lap(statistics.physics_seconds);
   }

@@ -284,9 +284,42 @@ namespace lacerta::cut
     std::unordered_map<std::uint64_t, Crossing>::iterator
     forget_crossing(std::unordered_map<std::uint64_t, Crossing>::iterator it);
     /// Replaces `removed` by the children of `results`, copies the vertices on the
-    /// cut, updates masses, springs and the active set.
+    /// cut, updates masses, springs and the active set: the stages below.
     void
     apply(const Blade &end, CutStepStatistics &statistics);
+
+    /// A cell's lumped mass contributions (Section 3.1) and its stiffness factor
+    /// E·V (Section 3.2).
+    struct CellTerms
+    {
+      std::array<double, 4> mass;
+      double                stiffness_factor;
+    };
+    /// The terms of cell @p t.
+    CellTerms
+    cell_terms(unsigned int t) const;
+    /// Adds @p sign (+1 or -1) times cell @p t's terms to its particles' masses and
+    /// its edges' springs, and the mass added to @p integral_delta.
+    void
+    add_cell_terms(unsigned int t, double sign, double &integral_delta);
+    /// A particle at rest position @p rest in cell @p parent, its state interpolated.
+    unsigned int
+    new_particle(const Point &rest, unsigned int parent, CutStepStatistics &statistics);
+    /// The children of `results` with their points (one particle per cut edge) and
+    /// boundary ids, into `children`, `child_cut_faces` and `face_ids`.
+    void
+    make_children(CutStepStatistics &statistics, CutRecord *record);
+    /// Copies every point on the cut once per group of its children connected through
+    /// faces not on the cut (separate_star()).
+    void
+    separate_points_on_cut(CutStepStatistics &statistics, CutRecord *record);
+    /// After the mesh update: springs follow the edges, the new cells' terms are added
+    /// (their mass to @p integral_delta), their boundary faces indexed.
+    void
+    update_springs_and_masses(double &integral_delta);
+    /// The active cells: the new ones blade @p end is in.
+    void
+    update_active_cells(const Blade &end);
 
     /// Vertex @p v lies on the cut of the current stroke.
     void
