@@ -98,6 +98,9 @@ namespace lacerta::cut
       , cut_parameters(cut_parameters_in)
       , parameters(parameters_in)
   {
+    // The mesh is torn locally, like the scalpel's (and the mass redistribution finds
+    // the springs around a particle through its cells).
+    mesh.enable_local_updates();
     // A bad limit anywhere on the object is reported now, not at the first tear.
     for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
       limit_at(mesh.vertex(v));
@@ -225,6 +228,7 @@ namespace lacerta::cut
   Lacerator::particles_replaced(const std::vector<std::uint8_t> &created_by_cut)
   {
     AssertDimension(created_by_cut.size(), system.n_particles());
+    mesh.enable_local_updates();
     surface_valid = false;
     for (Laceration &l : lacerations)
       l.cutter.reset();

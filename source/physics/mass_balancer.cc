@@ -1,3 +1,5 @@
+#include <lacerta/base/exceptions.h>
+#include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/mass_balancer.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/stability.h>
@@ -11,79 +13,27 @@ namespace lacerta::physics
 {
   namespace
   {
-    /// The springs at each particle, as (neighbour, spring) in compressed rows.
-    struct Neighbours
-    {
-      std::vector<unsigned int> offset, particle, spring;
-
-      explicit Neighbours(const ParticleSystem &system)
-          : offset(system.n_particles() + 1, 0)
-      {
-        const SpringSet &springs = system.springs;
-        for (std::size_t s = 0; s < springs.size(); ++s)
-        {
-          ++offset[springs.a[s] + 1];
-          ++offset[springs.b[s] + 1];
-        }
-        for (std::size_t i = 1; i < offset.size(); ++i)
-          offset[i] += offset[i - 1];
-        particle.resize(offset.back());
-        spring.resize(offset.back());
-        std::vector<unsigned int> next(offset.begin(), offset.end() - 1);
-        for (unsigned int s = 0; s < springs.size(); ++s)
-        {
-          const unsigned int a = springs.a[s], b = springs.b[s];
-          particle[next[a]] = b;
-          spring[next[a]++] = s;
-          particle[next[b]] = a;
-          spring[next[b]++] = s;
-        }
-      }
-    };
-
-
     /**
-     * The row sums of the block Gershgorin bound of M⁻¹K at rest, a_i + Σ_e c_e over
-     * the springs at i (gershgorin_terms()): the bound at particle i is that over m_i,
-     * whatever its neighbours weigh, so the mass a particle needs is its row sum over
-     * the target.
+     * Moves @p amount of mass from particle @p from to particle @p to, with the
+     * velocity of @p from: momentum is kept, and kinetic energy cannot grow (a particle
+     * made heavier at its own velocity would gain energy from nothing).
      */
-    class RestBound
+    void
+    move_mass(ParticleSystem    &system,
+              const unsigned int from,
+              const unsigned int to,
+              const double       amount)
     {
-    public:
-      RestBound(const ParticleSystem &system)
-          : system(system)
-          , neighbours(system)
-      {
-        const GershgorinTerms terms =
-          gershgorin_terms(system, system.rest_position().data());
-        row = terms.diagonal;
-        for (std::size_t s = 0; s < system.springs.size(); ++s)
-        {
-          row[system.springs.a[s]] += terms.coupling[s];
-          row[system.springs.b[s]] += terms.coupling[s];
-        }
-      }
-
-      /// The bound λ_i (infinite for a mass that is not positive).
-      double
-      lambda(const unsigned int i) const
-      {
-        const double m = system.mass[i];
-        return m > 0 ? row[i] / m : std::numeric_limits<double>::infinity();
-      }
-
-      /// The mass at which λ_i equals @p target.
-      double
-      needed(const unsigned int i, const double target) const
-      {
-        return row[i] / target;
-      }
-
-      const ParticleSystem &system;
-      const Neighbours      neighbours;
-      std::vector<double>   row;
-    };
+      const double m = system.mass[to] + amount;
+      for (unsigned int c = 0; c < 3; ++c)
+        system.velocity[3 * to + c] = m > 0
+                                        ? (system.mass[to] * system.velocity[3 * to + c]
+                                           + amount * system.velocity[3 * from + c])
+                                            / m
+                                        : system.velocity[3 * from + c];
+      system.mass[from] -= amount;
+      system.mass[to] = m;
+    }
 
 
     /**
@@ -93,17 +43,21 @@ namespace lacerta::physics
      * keeps its own bound at @p limit); otherwise it gives all it can and the next ring
      * is asked. All or nothing: when the particles within reach cannot spare @p need
      * together, nothing moves (mass that leaves the particle above the target does not
-     * lower the largest bound, and only changes the dynamics). Returns the mass moved.
+     * lower the largest bound, and only changes the dynamics). Calls
+     * @p on_gift(donor, mass) for every gift; returns the mass moved.
      */
+    template <typename ForEachNeighbour, typename RowSum, typename OnGift>
     double
-    borrow(ParticleSystem      &system,
-           const RestBound     &bound,
-           const unsigned int   i,
-           const double         need,
-           const double         limit,
-           const unsigned int   reach,
-           std::vector<char>   &seen,
-           std::vector<double> &spare)
+    borrow(ParticleSystem         &system,
+           const ForEachNeighbour &for_each_neighbour,
+           const RowSum           &row_sum,
+           const unsigned int      i,
+           const double            need,
+           const double            limit,
+           const unsigned int      reach,
+           std::vector<char>      &seen,
+           std::vector<double>    &spare,
+           const OnGift           &on_gift)
     {
       // The donors, ring by ring (ring r starts at first[r]), and what each can spare.
       std::vector<unsigned int> donors, first = {0};
@@ -113,19 +67,20 @@ namespace lacerta::physics
       for (unsigned int hop = 0; hop < reach && available < need && !ring.empty(); ++hop)
       {
         for (const unsigned int p : ring)
-          for (unsigned int k = bound.neighbours.offset[p];
-               k < bound.neighbours.offset[p + 1];
-               ++k)
-          {
-            const unsigned int j = bound.neighbours.particle[k];
-            if (seen[j] || !(system.free[j] > 0))
-              continue;
-            seen[j] = 1;
-            spare[donors.size()] =
-              std::max(0.0, 0.5 * (system.mass[j] - bound.needed(j, limit)));
-            available += spare[donors.size()];
-            donors.push_back(j);
-          }
+          for_each_neighbour(p,
+                             [&](const unsigned int j)
+                             {
+                               if (seen[j] || !(system.free[j] > 0))
+                                 return;
+                               seen[j] = 1;
+                               if (spare.size() <= donors.size())
+                                 spare.resize(2 * donors.size() + 16);
+                               spare[donors.size()] =
+                                 std::max(0.0,
+                                          0.5 * (system.mass[j] - row_sum(j) / limit));
+                               available += spare[donors.size()];
+                               donors.push_back(j);
+                             });
         ring.assign(donors.begin() + first.back(), donors.end());
         first.push_back(donors.size());
       }
@@ -145,8 +100,9 @@ namespace lacerta::physics
         for (unsigned int d = first[r]; d < first[r + 1]; ++d)
         {
           const double given = fraction * spare[d];
-          system.mass[donors[d]] -= given;
-          system.mass[i] += given;
+          move_mass(system, donors[d], i, given);
+          if (given > 0)
+            on_gift(donors[d], given);
         }
         left -= fraction * in_ring;
       }
@@ -155,62 +111,315 @@ namespace lacerta::physics
   } // namespace
 
 
+  void
+  MassBalancer::require_mesh(const ParticleSystem &system)
+  {
+    if (system.mesh == nullptr || !system.mesh->has_local_updates())
+      throw_error("MassBalancer: internal error, the particle system needs its mesh, "
+                  "with local updates (TetMesh::enable_local_updates()): the springs "
+                  "around a particle are found through its cells.");
+  }
+
+
+  void
+  MassBalancer::record_gift(const unsigned int donor,
+                            const unsigned int taker,
+                            const double       mass)
+  {
+    const auto id = static_cast<unsigned int>(gifts.size());
+    gifts.push_back({donor, taker, mass});
+    gifts_of[donor].push_back(id);
+    gifts_of[taker].push_back(id);
+    ++n_live_gifts;
+  }
+
+
+  void
+  MassBalancer::compact_gifts()
+  {
+    // Gifts taken back stay in the ledger until they are most of it: then it is
+    // rebuilt from the live ones (amortised over the gifts taken back).
+    if (gifts.size() < 1024 || gifts.size() < 2 * std::size_t(n_live_gifts))
+      return;
+    std::vector<Gift> live;
+    live.reserve(n_live_gifts);
+    for (const Gift &g : gifts)
+      if (g.mass > 0)
+        live.push_back(g);
+    gifts.clear();
+    n_live_gifts = 0;
+    for (auto &list : gifts_of)
+      list.clear();
+    for (const Gift &g : live)
+      record_gift(g.donor, g.taker, g.mass);
+  }
+
+
   MassBalancer::MassBalancer(const ParticleSystem &system, const unsigned int reach)
       : target_lambda(0)
       , reach(std::max(1u, reach))
   {
-    const RestBound bound(system);
+    require_mesh(system);
+    // The row sums at rest of every particle, the bound at each over its mass.
+    std::vector<unsigned int> all(system.n_particles());
+    for (unsigned int i = 0; i < system.n_particles(); ++i)
+      all[i] = i;
+    std::vector<double> row(all.size());
+    gershgorin_row_sums(system, system.rest_position().data(), all, scratch, row.data());
     for (unsigned int i = 0; i < system.n_particles(); ++i)
       if (system.free[i] > 0)
-        target_lambda = std::max(target_lambda, bound.lambda(i));
+        target_lambda =
+          std::max(target_lambda,
+                   system.mass[i] > 0 ? row[i] / system.mass[i]
+                                      : std::numeric_limits<double>::infinity());
   }
 
 
   MassBalanceStatistics
-  MassBalancer::balance(ParticleSystem &system) const
+  MassBalancer::balance(ParticleSystem &system)
   {
-    MassBalanceStatistics statistics;
-    if (!(target_lambda > 0) || !std::isfinite(target_lambda))
-      return statistics;
+    // From the lumped masses: the result depends on the mesh, not on the changes that
+    // led to it. Then every particle is a changed one.
     const unsigned int        n      = system.n_particles();
     const std::vector<double> before = system.mass;
-    // From the lumped masses every time: the result depends on the mesh, not on the
-    // changes that led to it, and a particle that gave mass and lost cells since is
-    // not left with too little.
     system.mass_shift.resize(n, 0.0);
     for (unsigned int i = 0; i < n; ++i)
+    {
       system.mass[i] -= system.mass_shift[i];
-    const std::vector<double> lumped = system.mass;
-    const RestBound           bound(system);
-    std::vector<char>         seen(n, 0);
-    std::vector<double>       spare(n);
-    // The bound is itself computed in floating point: a particle just above a limit is
-    // left alone.
-    const double tolerance = 1 + 1e-9;
-    const double limit     = donor_headroom * target_lambda;
-    // A particle's need does not depend on its neighbours' masses: one pass, in the
-    // order of the particles, raises every particle above the target (a donor never
-    // falls below the mass that keeps it at the donors' limit).
-    for (unsigned int i = 0; i < n; ++i)
-    {
-      if (!(system.free[i] > 0) || !(bound.lambda(i) > tolerance * target_lambda))
-        continue;
-      // Aim a little below the target so that rounding leaves nothing to do.
-      const double need  = bound.needed(i, target_lambda / (1 + 1e-6)) - system.mass[i];
-      const double moved = borrow(system, bound, i, need, limit, reach, seen, spare);
-      statistics.moved += moved;
-      statistics.raised += moved > 0;
+      system.mass_shift[i] = 0;
     }
-    std::vector<unsigned int> changed;
+    gifts.clear();
+    gifts_of.assign(n, {});
+    n_live_gifts   = 0;
+    positive_shift = 0;
+    n_unresolved   = 0;
+    unresolved.assign(n, 0);
+    std::vector<unsigned int> all(n);
     for (unsigned int i = 0; i < n; ++i)
-    {
-      statistics.unresolved += system.free[i] > 0 && bound.lambda(i) > tolerance * limit;
-      system.mass_shift[i] = system.mass[i] - lumped[i];
+      all[i] = i;
+    const MassBalanceStatistics statistics = rebalance(system, all);
+    std::vector<unsigned int>   changed;
+    for (unsigned int i = 0; i < n; ++i)
       if (system.mass[i] != before[i])
         changed.push_back(i);
+    if (!changed.empty())
+      system.masses_changed(changed);
+    return statistics;
+  }
+
+
+  MassBalanceStatistics
+  MassBalancer::rebalance(ParticleSystem                  &system,
+                          const std::vector<unsigned int> &particles)
+  {
+    MassBalanceStatistics statistics;
+    const unsigned int    n = system.n_particles();
+    system.mass_shift.resize(n, 0.0);
+    unresolved.resize(n, 0);
+    if (!(target_lambda > 0) || !std::isfinite(target_lambda) || particles.empty())
+    {
+      statistics.moved      = positive_shift;
+      statistics.unresolved = n_unresolved;
+      return statistics;
+    }
+    require_mesh(system);
+    const mesh::TetMesh &mesh = *system.mesh;
+    // The particles joined to p by a spring: the other vertices of its cells.
+    mark.resize(n, 0);
+    const auto for_each_neighbour = [&](const unsigned int p, const auto &f)
+    {
+      if (++stamp == 0)
+      {
+        std::fill(mark.begin(), mark.end(), 0);
+        stamp = 1;
+      }
+      mark[p] = stamp;
+      for (const unsigned int t : mesh.tets_of_vertex(p))
+        for (const unsigned int q : mesh.tet(t))
+          if (mark[q] != stamp)
+          {
+            mark[q] = stamp;
+            f(q);
+          }
+    };
+    // The particles within reach of @p start (distinct), appended to `region` after
+    // them; in_region marks them all.
+    in_region.resize(n, 0);
+    const auto grow_region = [&](const std::vector<unsigned int> &start)
+    {
+      region.clear();
+      for (const unsigned int p : start)
+        if (!in_region[p])
+        {
+          in_region[p] = 1;
+          region.push_back(p);
+        }
+      for (std::size_t first = 0, hop = 0; hop < reach; ++hop)
+      {
+        const std::size_t last = region.size();
+        for (std::size_t k = first; k < last; ++k)
+          for_each_neighbour(region[k],
+                             [&](const unsigned int q)
+                             {
+                               if (!in_region[q])
+                               {
+                                 in_region[q] = 1;
+                                 region.push_back(q);
+                               }
+                             });
+        first = last;
+      }
+    };
+    gifts_of.resize(n);
+    before_of.resize(n, 0.0);
+    momentum_of.resize(3 * std::size_t(n), 0.0);
+    touched.clear();
+    const auto touch = [&](const unsigned int p)
+    {
+      if (touched_mark[p] != touched_stamp)
+      {
+        touched_mark[p] = touched_stamp;
+        touched.push_back(p);
+        before_of[p] = system.mass[p];
+      }
+    };
+    // Gifts between particles within reach of the change are taken back: the change
+    // may have separated giver and taker (a cut between them crosses an edge of every
+    // path of at most `reach` springs, at changed particles), and the changed
+    // particles' needs are decided again. Their takers are checked again too.
+    to_check.assign(particles.begin(), particles.end());
+    std::sort(to_check.begin(), to_check.end());
+    to_check.erase(std::unique(to_check.begin(), to_check.end()), to_check.end());
+    touched_mark.resize(n, 0);
+    if (++touched_stamp == 0)
+    {
+      std::fill(touched_mark.begin(), touched_mark.end(), 0);
+      touched_stamp = 1;
+    }
+    grow_region(to_check);
+    // A taker that gave on some of what it took would owe it: its own gifts are
+    // taken back with it (cascade). The gifts are taken back at once, each with the
+    // velocity its taker has now: taken back one after the other, a particle could
+    // hold a negative mass in between, and the velocity of what it then receives
+    // would be divided by it.
+    cascade.clear();
+    taken_back.clear();
+    const auto take_back = [&](const unsigned int g)
+    {
+      Gift &gift = gifts[g];
+      touch(gift.donor);
+      touch(gift.taker);
+      taken_back.push_back(g);
+      to_check.push_back(gift.taker);
+      cascade.push_back(gift.taker);
+      returned[g] = gift.mass;
+      gift.mass   = 0;
+      --n_live_gifts;
+    };
+    returned.resize(gifts.size(), 0.0);
+    for (const unsigned int p : region)
+      for (const unsigned int g : gifts_of[p])
+        if (gifts[g].mass > 0)
+          take_back(g);
+    while (!cascade.empty())
+    {
+      const unsigned int t = cascade.back();
+      cascade.pop_back();
+      for (const unsigned int g : gifts_of[t])
+        if (gifts[g].mass > 0 && gifts[g].donor == t)
+          take_back(g);
+    }
+    // Mass and momentum, from the state before: each gift goes back to its donor with
+    // its taker's velocity.
+    for (const unsigned int p : touched)
+      for (unsigned int c = 0; c < 3; ++c)
+        momentum_of[3 * p + c] = system.mass[p] * system.velocity[3 * p + c];
+    for (const unsigned int g : taken_back)
+    {
+      const Gift  &gift = gifts[g];
+      const double m    = returned[g];
+      system.mass[gift.taker] -= m;
+      system.mass[gift.donor] += m;
+      for (unsigned int c = 0; c < 3; ++c)
+      {
+        const double p = m * system.velocity[3 * gift.taker + c];
+        momentum_of[3 * gift.taker + c] -= p;
+        momentum_of[3 * gift.donor + c] += p;
+      }
+    }
+    for (const unsigned int p : touched)
+      if (system.mass[p] > 0)
+        for (unsigned int c = 0; c < 3; ++c)
+          system.velocity[3 * p + c] = momentum_of[3 * p + c] / system.mass[p];
+    compact_gifts();
+    for (const unsigned int p : region)
+      in_region[p] = 0;
+    std::sort(to_check.begin(), to_check.end());
+    to_check.erase(std::unique(to_check.begin(), to_check.end()), to_check.end());
+    // The region to balance: the particles to check and their donors.
+    grow_region(to_check);
+    const std::size_t n_changed = to_check.size();
+    row_sum.resize(region.size());
+    gershgorin_row_sums(
+      system, system.rest_position().data(), region, scratch, row_sum.data());
+    row_of.resize(n, 0);
+    for (std::size_t k = 0; k < region.size(); ++k)
+      row_of[region[k]] = static_cast<unsigned int>(k);
+    const auto row    = [&](const unsigned int j) { return row_sum[row_of[j]]; };
+    const auto lambda = [&](const unsigned int i)
+    {
+      const double m = system.mass[i];
+      return m > 0 ? row(i) / m : std::numeric_limits<double>::infinity();
+    };
+
+    // As balance() does, over the changed particles only (in increasing order), from
+    // the masses as they are: the cutter updates the lumped part of a mass and keeps
+    // the part moved before (mass_shift).
+    const double tolerance = 1 + 1e-9;
+    const double limit     = donor_headroom * target_lambda;
+    for (const unsigned int p : region)
+      touch(p);
+    seen.resize(n, 0);
+    for (std::size_t k = 0; k < n_changed; ++k)
+    {
+      const unsigned int i = region[k];
+      if (!(system.free[i] > 0) || !(lambda(i) > tolerance * target_lambda))
+        continue;
+      const double need = row(i) / (target_lambda / (1 + 1e-6)) - system.mass[i];
+      const double moved =
+        borrow(system,
+               for_each_neighbour,
+               row,
+               i,
+               need,
+               limit,
+               reach,
+               seen,
+               spare,
+               [&](const unsigned int d, const double m) { record_gift(d, i, m); });
+      statistics.raised += moved > 0;
+    }
+    for (const unsigned int p : region)
+    {
+      in_region[p]     = 0;
+      const bool above = system.free[p] > 0 && lambda(p) > tolerance * limit;
+      n_unresolved += static_cast<unsigned int>(above) - unresolved[p];
+      unresolved[p] = above;
+    }
+    std::vector<unsigned int> changed;
+    for (const unsigned int p : touched)
+    {
+      if (system.mass[p] == before_of[p])
+        continue;
+      positive_shift -= std::max(0.0, system.mass_shift[p]);
+      system.mass_shift[p] += system.mass[p] - before_of[p];
+      positive_shift += std::max(0.0, system.mass_shift[p]);
+      changed.push_back(p);
     }
     if (!changed.empty())
       system.masses_changed(changed);
+    statistics.moved      = positive_shift;
+    statistics.unresolved = n_unresolved;
     return statistics;
   }
 } // namespace lacerta::physics

@@ -200,6 +200,95 @@ namespace lacerta::physics
   }
 
 
+  namespace
+  {
+    /**
+     * The mass-independent terms of the rows @p rows (distinct) into @p w: the
+     * diagonal blocks Σ_e K_e of every row (w.blocks) and ||K_e|| of every spring at a
+     * row (w.pair_norm, for w.springs, in spring order), from the springs and the force
+     * model's tetrahedra around the rows at positions @p x.
+     */
+    void
+    gather_row_terms(const ParticleSystem            &system,
+                     const double                    *x,
+                     const std::vector<unsigned int> &rows,
+                     GershgorinRowScratch            &w)
+    {
+      const mesh::TetMesh &mesh    = *system.mesh;
+      const SpringSet     &springs = system.springs;
+      ++w.stamp;
+      w.row_of.resize(system.n_particles(), 0);
+      w.row_stamp.resize(system.n_particles(), 0);
+      w.spring_stamp.resize(springs.size(), 0);
+      w.spring_of.resize(springs.size(), 0);
+      w.tet_stamp.resize(mesh.n_tets(), 0);
+      for (std::size_t r = 0; r < rows.size(); ++r)
+      {
+        w.row_stamp[rows[r]] = w.stamp;
+        w.row_of[rows[r]]    = static_cast<unsigned int>(r);
+      }
+      const auto is_row = [&](const unsigned int p) { return w.row_stamp[p] == w.stamp; };
+      // The tetrahedra around the rows, and the springs (edges) at the rows.
+      w.tets.clear();
+      w.springs.clear();
+      for (const unsigned int p : rows)
+        for (const unsigned int t : mesh.tets_of_vertex(p))
+        {
+          if (w.tet_stamp[t] == w.stamp)
+            continue;
+          w.tet_stamp[t] = w.stamp;
+          w.tets.push_back(t);
+          for (const unsigned int s : mesh.tet_edges(t))
+            if (w.spring_stamp[s] != w.stamp
+                && (is_row(springs.a[s]) || is_row(springs.b[s])))
+            {
+              w.spring_stamp[s] = w.stamp;
+              w.springs.push_back(s);
+            }
+        }
+      // In spring order, so that the stiffest spring is chosen as gershgorin_terms()
+      // chooses it among equals.
+      std::sort(w.springs.begin(), w.springs.end());
+      for (std::size_t k = 0; k < w.springs.size(); ++k)
+        w.spring_of[w.springs[k]] = static_cast<unsigned int>(k);
+      w.blocks.assign(rows.size(), std::array<double, 6>{});
+      w.pair_norm.assign(w.springs.size(), 0.0);
+      const double scale = spring_scale(system);
+      for (std::size_t k = 0; k < w.springs.size(); ++k)
+      {
+        const unsigned int          s = w.springs[k];
+        const std::array<double, 6> block =
+          spring_tangent_block(springs, s, x, scale, w.pair_norm[k]);
+        for (const unsigned int p : {springs.a[s], springs.b[s]})
+          if (is_row(p))
+            add_block(w.blocks[w.row_of[p]], block);
+      }
+      if (system.has_force_model())
+        system.force_model().for_each_element_stiffness_of(
+          system,
+          x,
+          w.tets,
+          [&](const unsigned int t, const ForceModel::ElementStiffness &K)
+          {
+            const mesh::Tet &tet = mesh.tet(t);
+            element_terms(
+              K,
+              [&](unsigned int a, const std::array<double, 6> &b)
+              {
+                if (is_row(tet[a]))
+                  add_block(w.blocks[w.row_of[tet[a]]], b);
+              },
+              [&](unsigned int e, double norm)
+              {
+                const unsigned int s = mesh.tet_edges(t)[e];
+                if (w.spring_stamp[s] == w.stamp)
+                  w.pair_norm[w.spring_of[s]] += norm;
+              });
+          });
+    }
+  } // namespace
+
+
   void
   gershgorin_rows(const ParticleSystem            &system,
                   const double                    *x,
@@ -208,78 +297,10 @@ namespace lacerta::physics
                   double                          *lambda,
                   unsigned int                    *stiffest_spring)
   {
-    const mesh::TetMesh  &mesh    = *system.mesh;
     const SpringSet      &springs = system.springs;
     GershgorinRowScratch &w       = scratch;
-    ++w.stamp;
-    w.row_of.resize(system.n_particles(), 0);
-    w.row_stamp.resize(system.n_particles(), 0);
-    w.spring_stamp.resize(springs.size(), 0);
-    w.spring_of.resize(springs.size(), 0);
-    w.tet_stamp.resize(mesh.n_tets(), 0);
-    for (std::size_t r = 0; r < rows.size(); ++r)
-    {
-      w.row_stamp[rows[r]] = w.stamp;
-      w.row_of[rows[r]]    = static_cast<unsigned int>(r);
-    }
+    gather_row_terms(system, x, rows, w);
     const auto is_row = [&](const unsigned int p) { return w.row_stamp[p] == w.stamp; };
-    // The tetrahedra around the rows, and the springs (edges) at the rows.
-    w.tets.clear();
-    w.springs.clear();
-    for (const unsigned int p : rows)
-      for (const unsigned int t : mesh.tets_of_vertex(p))
-      {
-        if (w.tet_stamp[t] == w.stamp)
-          continue;
-        w.tet_stamp[t] = w.stamp;
-        w.tets.push_back(t);
-        for (const unsigned int s : mesh.tet_edges(t))
-          if (w.spring_stamp[s] != w.stamp
-              && (is_row(springs.a[s]) || is_row(springs.b[s])))
-          {
-            w.spring_stamp[s] = w.stamp;
-            w.springs.push_back(s);
-          }
-      }
-    // In spring order, so that the stiffest spring is chosen as gershgorin_terms()
-    // chooses it among equals.
-    std::sort(w.springs.begin(), w.springs.end());
-    for (std::size_t k = 0; k < w.springs.size(); ++k)
-      w.spring_of[w.springs[k]] = static_cast<unsigned int>(k);
-    w.blocks.assign(rows.size(), std::array<double, 6>{});
-    w.pair_norm.assign(w.springs.size(), 0.0);
-    const double scale = spring_scale(system);
-    for (std::size_t k = 0; k < w.springs.size(); ++k)
-    {
-      const unsigned int          s = w.springs[k];
-      const std::array<double, 6> block =
-        spring_tangent_block(springs, s, x, scale, w.pair_norm[k]);
-      for (const unsigned int p : {springs.a[s], springs.b[s]})
-        if (is_row(p))
-          add_block(w.blocks[w.row_of[p]], block);
-    }
-    if (system.has_force_model())
-      system.force_model().for_each_element_stiffness_of(
-        system,
-        x,
-        w.tets,
-        [&](const unsigned int t, const ForceModel::ElementStiffness &K)
-        {
-          const mesh::Tet &tet = mesh.tet(t);
-          element_terms(
-            K,
-            [&](unsigned int a, const std::array<double, 6> &b)
-            {
-              if (is_row(tet[a]))
-                add_block(w.blocks[w.row_of[tet[a]]], b);
-            },
-            [&](unsigned int e, double norm)
-            {
-              const unsigned int s = mesh.tet_edges(t)[e];
-              if (w.spring_stamp[s] == w.stamp)
-                w.pair_norm[w.spring_of[s]] += norm;
-            });
-        });
     // The rows, as squared_frequency_bounds() makes them from gershgorin_terms().
     w.off_diagonal.assign(rows.size(), 0.0);
     w.stiffest.assign(rows.size(), 0.0);
@@ -309,6 +330,30 @@ namespace lacerta::physics
       lambda[r]            = system.free[i] > 0 && system.mass[i] > 0
                                ? largest_eigenvalue(w.blocks[r]) / system.mass[i] + w.off_diagonal[r]
                                : 0.0;
+    }
+  }
+
+
+  void
+  gershgorin_row_sums(const ParticleSystem            &system,
+                      const double                    *x,
+                      const std::vector<unsigned int> &rows,
+                      GershgorinRowScratch            &scratch,
+                      double                          *row_sum)
+  {
+    const SpringSet      &springs = system.springs;
+    GershgorinRowScratch &w       = scratch;
+    gather_row_terms(system, x, rows, w);
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      row_sum[r] = largest_eigenvalue(w.blocks[r]);
+    for (std::size_t k = 0; k < w.springs.size(); ++k)
+    {
+      const unsigned int s = w.springs[k], i = springs.a[s], j = springs.b[s];
+      if (!(system.free[i] > 0 && system.free[j] > 0))
+        continue;
+      for (const unsigned int p : {i, j})
+        if (w.row_stamp[p] == w.stamp)
+          row_sum[w.row_of[p]] += w.pair_norm[k];
     }
   }
 

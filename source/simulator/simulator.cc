@@ -197,16 +197,17 @@ namespace lacerta
       "the state is also checked before every output.");
     prm.declare_entry(
       "Mass redistribution",
-      "false",
+      "true",
       dealii::Patterns::Bool(),
-      "After every topology change (a cut, a tear, a new level of detail), raise the "
-      "mass of each free particle whose Gershgorin bound at rest exceeds the bound of "
-      "the system at the start, taking it from particles joined to it by springs "
-      "(the mass of every piece stays the integral of the density over it), when the "
-      "particles within reach can spare it. Small cells next to a cut then do not "
-      "lower the critical time step (doc/stability.md). Off by default: it changes "
-      "the dynamics near a cut, and the cutter still judges crossings where the "
-      "tissue is. false: masses are the lumped integrals of the density.");
+      "In a scene that can cut or tear (a tool, or lacerations), after every topology "
+      "change (a cut, a tear, a new level of detail), raise the mass of each free "
+      "particle whose Gershgorin bound at rest exceeds the bound of the system at the "
+      "start, taking it from particles joined to it by springs (the mass of every "
+      "piece stays the integral of the density over it), when the particles within "
+      "reach can spare it. Small cells next to a cut then do not lower the critical "
+      "time step (doc/stability.md). After a cut or a tear only the particles it "
+      "changed are raised. false: masses are the lumped integrals of the density. "
+      "Scenes that neither cut nor tear keep the lumped masses.");
     prm.declare_entry("Redistribution reach",
                       "3",
                       dealii::Patterns::Integer(1, 8),
@@ -320,7 +321,8 @@ namespace lacerta
                                          scene->cutter || scene->lacerator
                                            ? std::vector<std::string>{"cut tables"}
                                            : std::vector<std::string>{});
-    if (redistribute_mass)
+    // Only cuts and tears make the small cells the redistribution is for.
+    if (redistribute_mass && (scene->cutter || scene->lacerator))
       mass_balancer =
         std::make_unique<physics::MassBalancer>(*scene->system, redistribution_reach);
     integrator->initialize(*scene->system);
@@ -582,7 +584,12 @@ namespace lacerta
     physics::ParticleSystem &system = *scene->system;
     if (mass_balancer)
     {
-      const physics::MassBalanceStatistics b = mass_balancer->balance(system);
+      // A local change is balanced locally (nothing global per cut); a new level of
+      // detail, whose masses are all lumped anew, as a whole.
+      const physics::MassBalanceStatistics b =
+        change.reassembled() || system.all_particles_changed()
+          ? mass_balancer->balance(system)
+          : mass_balancer->rebalance(system, system.changed_particles());
       redistribution.largest_moved   = std::max(redistribution.largest_moved, b.moved);
       redistribution.last_unresolved = b.unresolved;
       ++redistribution.n_balances;

@@ -661,14 +661,80 @@ TEST(CutCutter, VerticesSweptOnThePlaneStayOnItWhenTheTissueMovesThemOff)
 }
 
 
+namespace
+{
+  /// The particles whose row bound at rest is above the donors' limit are the
+  /// @p unresolved that @p balancer reported, fewer than a quarter; returns the bounds.
+  std::vector<double>
+  expect_unresolved_are_those_above_the_limit(const physics::ParticleSystem &system,
+                                              const physics::MassBalancer   &balancer,
+                                              const unsigned int             unresolved)
+  {
+    const std::vector<double> row = test_support::rest_row_bounds(system);
+    const double              limit =
+      physics::MassBalancer::donor_headroom * balancer.target() * (1 + 1e-9);
+    EXPECT_EQ(static_cast<unsigned int>(std::count_if(
+                row.begin(), row.end(), [&](double l) { return l > limit; })),
+              unresolved);
+    EXPECT_LT(unresolved, system.n_particles() / 4);
+    return row;
+  }
+
+
+  /// The fixture's mesh is in two pieces, and every piece keeps the mass ∫σ over it
+  /// (density 1000): the particles of a piece are those of its cells (a face-connected
+  /// component).
+  void
+  expect_two_pieces_of_their_mass(const CutFixture &f)
+  {
+    const unsigned int        n_tets = f.mesh.n_tets();
+    std::vector<unsigned int> piece(n_tets, n_tets);
+    unsigned int              n_pieces = 0;
+    for (unsigned int t = 0; t < n_tets; ++t)
+      if (piece[t] == n_tets)
+      {
+        std::vector<unsigned int> queue = {t};
+        piece[t]                        = n_pieces;
+        while (!queue.empty())
+        {
+          const unsigned int c = queue.back();
+          queue.pop_back();
+          for (unsigned int k = 0; k < 4; ++k)
+            if (const unsigned int d = f.mesh.neighbor(c, k);
+                d != mesh::invalid_index && piece[d] == n_tets)
+            {
+              piece[d] = n_pieces;
+              queue.push_back(d);
+            }
+        }
+        ++n_pieces;
+      }
+    ASSERT_EQ(n_pieces, 2u);
+    std::vector<double> volume(2, 0.0), mass(2, 0.0);
+    std::vector<int>    piece_of_vertex(f.mesh.n_vertices(), -1);
+    for (unsigned int t = 0; t < n_tets; ++t)
+    {
+      volume[piece[t]] += f.mesh.volume(t);
+      for (const unsigned int v : f.mesh.tet(t))
+        piece_of_vertex[v] = static_cast<int>(piece[t]);
+    }
+    for (unsigned int v = 0; v < f.mesh.n_vertices(); ++v)
+      if (piece_of_vertex[v] >= 0)
+        mass[piece_of_vertex[v]] += f.system->mass[v];
+    for (unsigned int p = 0; p < 2; ++p)
+      EXPECT_NEAR(mass[p], 1000.0 * volume[p], 1e-9 * 1000.0) << "piece " << p;
+  }
+} // namespace
+
+
 TEST(CutCutter, ACutNearAVertexLayerKeepsTheCriticalStepWithMassRedistribution)
 {
   // The plane y = 0.4825 passes 7 % of an edge (0.25) from the vertex layer y = 0.5,
   // above the snap fraction: the cells between are thin and their particles light.
-  std::mt19937                rng(3);
-  CutFixture                  f(4, rng, vertical(-0.2, 0.4825));
-  const physics::MassBalancer balancer(*f.system, 3);
-  const double                before = physics::bound_highest_frequency(*f.system).omega;
+  std::mt19937          rng(3);
+  CutFixture            f(4, rng, vertical(-0.2, 0.4825));
+  physics::MassBalancer balancer(*f.system, 3);
+  const double          before = physics::bound_highest_frequency(*f.system).omega;
   f.stroke({vertical(-0.2, 0.4825), vertical(1.2, 0.4825)}, 8);
   ASSERT_FALSE(::testing::Test::HasFatalFailure());
   ASSERT_EQ(f.component_volumes().size(), 2u);
@@ -680,56 +746,73 @@ TEST(CutCutter, ACutNearAVertexLayerKeepsTheCriticalStepWithMassRedistribution)
   EXPECT_GT(s.raised, 0u);
   // Every free particle is under the donors' limit but those reported: the particles
   // whose springs are too stiff for the mass within reach (short edges of fat cells).
-  const std::vector<double> row = test_support::rest_row_bounds(*f.system);
-  const double              limit =
-    physics::MassBalancer::donor_headroom * balancer.target() * (1 + 1e-9);
-  EXPECT_EQ(static_cast<unsigned int>(
-              std::count_if(row.begin(), row.end(), [&](double l) { return l > limit; })),
-            s.unresolved);
-  EXPECT_LT(s.unresolved, f.system->n_particles() / 4);
+  const std::vector<double> row =
+    expect_unresolved_are_those_above_the_limit(*f.system, balancer, s.unresolved);
   // A particle above the limit only takes mass: the largest row bound never rises.
   EXPECT_LE(*std::max_element(row.begin(), row.end()),
             *std::max_element(cut_rows.begin(), cut_rows.end()));
   f.expect_invariants("after the redistribution");
 
-  // Every piece keeps the mass ∫σ over it: the particles of a piece are those of its
-  // cells (a face-connected component).
-  const unsigned int        n_tets = f.mesh.n_tets();
-  std::vector<unsigned int> piece(n_tets, n_tets);
-  unsigned int              n_pieces = 0;
-  for (unsigned int t = 0; t < n_tets; ++t)
-    if (piece[t] == n_tets)
-    {
-      std::vector<unsigned int> queue = {t};
-      piece[t]                        = n_pieces;
-      while (!queue.empty())
-      {
-        const unsigned int c = queue.back();
-        queue.pop_back();
-        for (unsigned int k = 0; k < 4; ++k)
-          if (const unsigned int d = f.mesh.neighbor(c, k);
-              d != mesh::invalid_index && piece[d] == n_tets)
-          {
-            piece[d] = n_pieces;
-            queue.push_back(d);
-          }
-      }
-      ++n_pieces;
-    }
-  ASSERT_EQ(n_pieces, 2u);
-  std::vector<double> volume(2, 0.0), mass(2, 0.0);
-  std::vector<int>    piece_of_vertex(f.mesh.n_vertices(), -1);
-  for (unsigned int t = 0; t < n_tets; ++t)
+  expect_two_pieces_of_their_mass(f);
+}
+
+
+TEST(CutCutter, LocalRebalancingAfterEveryBladeMotionKeepsTheCriticalStep)
+{
+  // As above, with the simulator's local redistribution after every blade motion that
+  // changed the mesh, from the particles that motion changed only.
+  std::mt19937          rng(3);
+  CutFixture            f(4, rng, vertical(-0.2, 0.4825));
+  physics::MassBalancer balancer(*f.system, 3);
+  f.system->clear_changes();
+  // A moving body, so that the momentum the mass carries matters.
+  std::uniform_real_distribution<double> speed(-1, 1);
+  for (double &v : f.system->velocity)
+    v = speed(rng);
+  physics::MassBalanceStatistics last;
+  unsigned int                   motions = 0, raised = 0;
+  f.after_step = [&](const cut::CutStepStatistics &s)
   {
-    volume[piece[t]] += f.mesh.volume(t);
-    for (const unsigned int v : f.mesh.tet(t))
-      piece_of_vertex[v] = static_cast<int>(piece[t]);
-  }
-  for (unsigned int v = 0; v < f.mesh.n_vertices(); ++v)
-    if (piece_of_vertex[v] >= 0)
-      mass[piece_of_vertex[v]] += f.system->mass[v];
-  for (unsigned int p = 0; p < 2; ++p)
-    EXPECT_NEAR(mass[p], 1000.0 * volume[p], 1e-9 * 1000.0) << "piece " << p;
+    if (!s.changed)
+      return;
+    ++motions;
+    // Mass only moves, with its momentum: the total mass and momentum stay, to
+    // rounding.
+    const auto totals = [&]
+    {
+      std::array<double, 4> t{{0, 0, 0, 0}};
+      for (unsigned int p = 0; p < f.system->n_particles(); ++p)
+      {
+        t[3] += f.system->mass[p];
+        for (unsigned int c = 0; c < 3; ++c)
+          t[c] += f.system->mass[p] * f.system->velocity[3 * p + c];
+      }
+      return t;
+    };
+    const std::array<double, 4> before = totals();
+    last = balancer.rebalance(*f.system, f.system->changed_particles());
+    raised += last.raised;
+    const std::array<double, 4> after = totals();
+    EXPECT_NEAR(after[3], before[3], 1e-12 * before[3]);
+    for (unsigned int c = 0; c < 3; ++c)
+      EXPECT_NEAR(after[c], before[c], 1e-12 * before[3]);
+    f.system->clear_changes();
+  };
+  f.stroke({vertical(-0.2, 0.4825), vertical(1.2, 0.4825)}, 8);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  ASSERT_GT(motions, 0u);
+  EXPECT_GT(raised, 0u);
+  ASSERT_EQ(f.component_volumes().size(), 2u);
+  // The particles above the donors' limit are those reported, a few (short edges of
+  // fat cells), and the mass moved is what the masses say.
+  expect_unresolved_are_those_above_the_limit(*f.system, balancer, last.unresolved);
+  double shifted = 0;
+  for (const double m : f.system->mass_shift)
+    shifted += std::max(0.0, m);
+  EXPECT_NEAR(last.moved, shifted, 1e-12);
+  EXPECT_GT(shifted, 0);
+  f.expect_invariants("after the local redistributions");
+  expect_two_pieces_of_their_mass(f);
 }
 
 

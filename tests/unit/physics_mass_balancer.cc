@@ -54,10 +54,11 @@ namespace
 
 TEST(PhysicsMassBalancer, TheSystemItWasMadeForNeedsNothing)
 {
-  const mesh::TetMesh         mesh   = test_support::distorted_box(4, 0.2, {1, 1, 1});
-  auto                        system = test_support::make_system(mesh, 1000, 1e4);
-  const std::vector<double>   before = system->mass;
-  const physics::MassBalancer balancer(*system, 3);
+  mesh::TetMesh mesh = test_support::distorted_box(4, 0.2, {1, 1, 1});
+  mesh.enable_local_updates();
+  auto                      system = test_support::make_system(mesh, 1000, 1e4);
+  const std::vector<double> before = system->mass;
+  physics::MassBalancer     balancer(*system, 3);
   EXPECT_NEAR(balancer.target(), rest_bound(*system), 1e-12 * balancer.target());
   const physics::MassBalanceStatistics s = balancer.balance(*system);
   EXPECT_EQ(s.raised, 0u);
@@ -68,9 +69,10 @@ TEST(PhysicsMassBalancer, TheSystemItWasMadeForNeedsNothing)
 
 TEST(PhysicsMassBalancer, ALightParticleIsRaisedToTheTargetFromItsNeighbours)
 {
-  const mesh::TetMesh         mesh   = test_support::distorted_box(4, 0.2, {1, 1, 1});
-  auto                        system = test_support::make_system(mesh, 1000, 1e4);
-  const physics::MassBalancer balancer(*system, 3);
+  mesh::TetMesh mesh = test_support::distorted_box(4, 0.2, {1, 1, 1});
+  mesh.enable_local_updates();
+  auto                  system = test_support::make_system(mesh, 1000, 1e4);
+  physics::MassBalancer balancer(*system, 3);
   // Most of one particle's mass goes to a neighbour, as when a cut leaves it with
   // small cells only: its bound rises far above the target.
   const unsigned int i = interior_particle(mesh);
@@ -98,16 +100,17 @@ TEST(PhysicsMassBalancer, ALightParticleIsRaisedToTheTargetFromItsNeighbours)
 
 TEST(PhysicsMassBalancer, AParticleWithoutMassIsGivenSomeAndConstrainedOnesKeepTheirs)
 {
-  const mesh::TetMesh mesh   = test_support::distorted_box(4, 0.1, {1, 1, 1});
-  auto                system = test_support::make_system(mesh, 1000, 1e4);
+  mesh::TetMesh mesh = test_support::distorted_box(4, 0.1, {1, 1, 1});
+  mesh.enable_local_updates();
+  auto system = test_support::make_system(mesh, 1000, 1e4);
   // The face x = 0 is held: its particles neither give nor take.
   for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
     if (mesh.vertex(v)[0] < 1e-12)
       system->free[v] = 0;
-  const physics::MassBalancer balancer(*system, 2);
-  const unsigned int          i      = interior_particle(mesh);
-  const std::vector<double>   before = system->mass;
-  const double                total  = total_mass(*system);
+  physics::MassBalancer     balancer(*system, 2);
+  const unsigned int        i      = interior_particle(mesh);
+  const std::vector<double> before = system->mass;
+  const double              total  = total_mass(*system);
   // A particle left with a negative mass (a donor that lost cells to a cut since).
   system->mass[i] = -0.1 * before[i];
   system->mass[(i + 1) % system->n_particles()] += 1.1 * before[i];
@@ -126,19 +129,20 @@ TEST(PhysicsMassBalancer, AParticleWithoutMassIsGivenSomeAndConstrainedOnesKeepT
 
 TEST(PhysicsMassBalancer, ATinyPieceOnItsOwnKeepsItsMassAndIsReported)
 {
-  // Two particles joined by one spring, far lighter than their stiffness allows, and
-  // nothing else within reach: mass cannot come from another piece.
-  const mesh::TetMesh         mesh   = test_support::distorted_box(2, 0, {1, 1, 1});
-  auto                        system = test_support::make_system(mesh, 1000, 1e4);
-  const physics::MassBalancer balancer(*system, 3);
-  physics::ParticleSystem     pair({0, 0, 0, 0.01, 0, 0});
-  pair.mass                              = {1e-9, 1e-9};
-  pair.springs.a                         = {0};
-  pair.springs.b                         = {1};
-  pair.springs.stiffness                 = {1e4};
-  pair.springs.rest_length               = {0.01};
-  const physics::MassBalanceStatistics s = balancer.balance(pair);
-  EXPECT_EQ(s.unresolved, 2u);
+  // One tetrahedron far lighter than its stiffness allows, and nothing else within
+  // reach: mass cannot come from another piece.
+  mesh::TetMesh mesh = test_support::distorted_box(2, 0, {1, 1, 1});
+  mesh.enable_local_updates();
+  auto                  system = test_support::make_system(mesh, 1000, 1e4);
+  physics::MassBalancer balancer(*system, 3);
+  mesh::TetMesh         tet({{{0, 0, 0}}, {{0.01, 0, 0}}, {{0, 0.01, 0}}, {{0, 0, 0.01}}},
+                    {{{0, 1, 2, 3}}},
+                    "one tetrahedron");
+  tet.enable_local_updates();
+  auto piece = test_support::make_system(tet, 1000, 1e4);
+  piece->mass.assign(4, 1e-9);
+  const physics::MassBalanceStatistics s = balancer.balance(*piece);
+  EXPECT_EQ(s.unresolved, 4u);
   EXPECT_EQ(s.moved, 0);
-  EXPECT_EQ(pair.mass[0] + pair.mass[1], 2e-9);
+  EXPECT_EQ(piece->mass, std::vector<double>(4, 1e-9));
 }

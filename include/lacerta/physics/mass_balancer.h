@@ -5,6 +5,11 @@
  */
 #pragma once
 
+#include <lacerta/physics/stability.h>
+
+#include <cstdint>
+#include <vector>
+
 namespace lacerta::physics
 {
   class ParticleSystem;
@@ -39,11 +44,14 @@ namespace lacerta::physics
    * `reach` springs away, nearest ring first). A donor gives at most half of what it
    * has above the mass that keeps its own bound at `donor_headroom` times the target,
    * so the bound rises by that factor at most (the critical time step falls by its
-   * square root, 1.41). A particle is raised only when the particles within reach can
-   * spare all it needs: partial help would not lower the largest bound and would only
-   * change the dynamics. Mass only moves along springs, so the mass of every connected
-   * piece, and the total, stay ∫σ over it; a particle's velocity is kept. Every call
-   * starts from the lumped masses (ParticleSystem::mass_shift records the difference).
+   * square root, 1.41). A particle is raised
+   * only when the particles within reach can spare all it needs: partial help would not
+   * lower the largest bound and would only change the dynamics. Mass only moves along
+   * springs, so the mass of every connected piece, and the total, stay ∫σ over it; it
+   * moves with the velocity of the particle it leaves, so momentum is kept and kinetic
+   * energy cannot grow. balance() starts from the lumped masses, rebalance() from the
+   * masses as they are, taking back the gifts near the change first
+   * (ParticleSystem::mass_shift records the difference from the lumped masses).
    */
   class MassBalancer
   {
@@ -60,7 +68,20 @@ namespace lacerta::physics
      * the target (or whose mass is not positive), taking it from its neighbours.
      */
     MassBalanceStatistics
-    balance(ParticleSystem &system) const;
+    balance(ParticleSystem &system);
+
+    /**
+     * After a local change of @p system (a cut or a tear): as balance(), but only the
+     * particles in @p particles (those the change touched,
+     * ParticleSystem::changed_particles()) are raised, from the masses as they are,
+     * with mass from the particles within reach of them. Particles the change did not
+     * touch keep their masses unless they give. The cost depends on the changed
+     * particles' neighbourhoods, not on the system. Needs `system.mesh` (its edges are
+     * the springs). The statistics are those of the whole system: the mass away from
+     * the lumped masses and the particles above the donors' limit, kept up to date.
+     */
+    MassBalanceStatistics
+    rebalance(ParticleSystem &system, const std::vector<unsigned int> &particles);
 
     /// The target: the bound on the highest eigenvalue ω² at rest (1/s²).
     double
@@ -76,5 +97,45 @@ namespace lacerta::physics
   private:
     double       target_lambda;
     unsigned int reach;
+    /// Σ max(0, mass_shift) and the particles above the donors' limit, after the last
+    /// call, with the per-particle flags.
+    double                    positive_shift = 0;
+    unsigned int              n_unresolved   = 0;
+    std::vector<std::uint8_t> unresolved;
+    /// Throws unless @p system has its mesh with local updates.
+    static void
+    require_mesh(const ParticleSystem &system);
+
+    /// Mass @p mass moved from particle @p donor to @p taker: the ledger rebalance()
+    /// takes gifts back from.
+    void
+    record_gift(unsigned int donor, unsigned int taker, double mass);
+
+    /// A gift of mass between two particles (mass 0 once taken back).
+    struct Gift
+    {
+      unsigned int donor, taker;
+      double       mass;
+    };
+    std::vector<Gift>                      gifts;
+    std::vector<std::vector<unsigned int>> gifts_of;
+    /// Takers whose own gifts are taken back with theirs, the gifts taken back and
+    /// their masses, the particles' momenta (rebalance()).
+    std::vector<unsigned int> cascade, taken_back;
+    std::vector<double>       returned, momentum_of;
+    unsigned int              n_live_gifts = 0;
+    /// Rebuilds the ledger without the gifts taken back once they are most of it.
+    void
+    compact_gifts();
+
+    /// Scratch of rebalance(), kept so that a local call allocates nothing once grown.
+    std::vector<unsigned int> region, row_of, mark, to_check, touched, touched_mark;
+    std::vector<double>       before_of;
+    unsigned int              touched_stamp = 0;
+    std::vector<std::uint8_t> in_region;
+    std::vector<char>         seen;
+    std::vector<double>       row_sum, spare;
+    unsigned int              stamp = 0;
+    GershgorinRowScratch      scratch;
   };
 } // namespace lacerta::physics

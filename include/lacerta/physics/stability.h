@@ -62,9 +62,9 @@ namespace lacerta::physics
   squared_frequency_bounds(const ParticleSystem &system, const GershgorinTerms &terms);
 
   /**
-   * Working space of gershgorin_rows(), kept between calls so that a local update
-   * allocates nothing once it has grown: marks per particle, spring and tetrahedron,
-   * and the terms of the rows being computed.
+   * Working space of gershgorin_rows() and gershgorin_row_sums(), kept between calls so
+   * that a local update allocates nothing once it has grown: marks per particle, spring
+   * and tetrahedron, and the terms of the rows being computed.
    */
   struct GershgorinRowScratch
   {
@@ -92,6 +92,20 @@ namespace lacerta::physics
                   GershgorinRowScratch            &scratch,
                   double                          *lambda,
                   unsigned int                    *stiffest_spring);
+
+  /**
+   * The mass-independent row sums a_i + Σ_e c_e of gershgorin_terms() (λ_max of the
+   * diagonal block plus ||K_e|| of every spring at i whose ends are both free) at the
+   * particles @p rows only (distinct), at positions @p x, into @p row_sum, one entry per
+   * row: what the row bound is before dividing by the particle's mass. At a cost that
+   * depends on the rows' stars only; needs `system.mesh` as gershgorin_rows() does.
+   */
+  void
+  gershgorin_row_sums(const ParticleSystem            &system,
+                      const double                    *x,
+                      const std::vector<unsigned int> &rows,
+                      GershgorinRowScratch            &scratch,
+                      double                          *row_sum);
 
   /**
    * Bounds the highest eigenvalue of M^-1/2 K M^-1/2 by block Gershgorin over the free
