@@ -314,9 +314,22 @@ namespace lacerta::cut
                        lengths.end());
       h = std::max(lengths[lengths.size() / 2], 0.1 * typical_edge);
     }
-    const unsigned int n = std::max(
-      1u, static_cast<unsigned int>(std::ceil(advance / (parameters.max_advance * h))));
-    const Blade start = current;
+    const double sweeps = std::ceil(advance / (parameters.max_advance * h));
+    if (!(sweeps <= max_sweeps_per_motion))
+      throw_error("Cutter: the blade moves ",
+                  advance,
+                  " m in one motion, which needs ",
+                  sweeps,
+                  " sweeps of at most ",
+                  parameters.max_advance * h,
+                  " m ('Cut/Maximum advance' times the element size around the blade, ",
+                  h,
+                  " m), more than ",
+                  max_sweeps_per_motion,
+                  ": the tool's path jumps, or the tissue around the blade has blown "
+                  "up.");
+    const unsigned int n     = std::max(1u, static_cast<unsigned int>(sweeps));
+    const Blade        start = current;
     // The tissue moves between blade motions: a crossing just ahead of where the last
     // motion ended can be carried behind where this one starts, and no sweep would
     // meet it. The first sweep therefore starts behind the blade by as far as the

@@ -330,10 +330,12 @@ namespace lacerta::physics
           take_back(g);
     }
     // Mass and momentum, from the state before: each gift goes back to its donor with
-    // its taker's velocity.
+    // its taker's velocity. What leaves a particle has its velocity, so only what
+    // arrives changes it: v += Σ m (v_from - v) / m_new, with no difference of large
+    // momenta that rounding would leave behind at a particle left light.
     for (const unsigned int p : touched)
       for (unsigned int c = 0; c < 3; ++c)
-        momentum_of[3 * p + c] = system.mass[p] * system.velocity[3 * p + c];
+        momentum_of[3 * p + c] = 0;
     for (const unsigned int g : taken_back)
     {
       const Gift  &gift = gifts[g];
@@ -341,16 +343,13 @@ namespace lacerta::physics
       system.mass[gift.taker] -= m;
       system.mass[gift.donor] += m;
       for (unsigned int c = 0; c < 3; ++c)
-      {
-        const double p = m * system.velocity[3 * gift.taker + c];
-        momentum_of[3 * gift.taker + c] -= p;
-        momentum_of[3 * gift.donor + c] += p;
-      }
+        momentum_of[3 * gift.donor + c] +=
+          m * (system.velocity[3 * gift.taker + c] - system.velocity[3 * gift.donor + c]);
     }
     for (const unsigned int p : touched)
       if (system.mass[p] > 0)
         for (unsigned int c = 0; c < 3; ++c)
-          system.velocity[3 * p + c] = momentum_of[3 * p + c] / system.mass[p];
+          system.velocity[3 * p + c] += momentum_of[3 * p + c] / system.mass[p];
     compact_gifts();
     for (const unsigned int p : region)
       in_region[p] = 0;

@@ -1,5 +1,6 @@
 // The cutter on a whole mesh with its particle system: scripted and randomised blade
 // strokes, with every invariant checked after every step.
+#include <lacerta/base/exceptions.h>
 #include <lacerta/cut/cutter.h>
 #include <lacerta/cut/invariants.h>
 #include <lacerta/physics/assembly.h>
@@ -123,6 +124,32 @@ TEST(CutCutter, CompleteStraightCutSeparatesTwoPiecesOfTheRightVolume)
   EXPECT_EQ(cut::count_components(f.mesh), 2u);
   // Snapping moves the surface by at most ε of an edge (0.05 * 0.25).
   EXPECT_NEAR(pieces[0], 0.37, 0.0125);
+}
+
+
+TEST(CutCutter, ABladeMotionOfTooManySweepsIsAClearErrorNotAHang)
+{
+  // A blade that jumps 1e9 m (as the blade a tear drives through tissue that has blown
+  // up): billions of sweeps. The motion is refused, naming its length, and the mesh is
+  // left as it was.
+  std::mt19937 rng(2);
+  CutFixture   f(4, rng, vertical(-0.2, 0.43));
+  f.stroke({vertical(-0.2, 0.43), vertical(0.5, 0.43)}, 4);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  const unsigned int n_tets = f.mesh.n_tets();
+  try
+  {
+    f.cutter->move_blade(vertical(1e9, 0.43));
+    FAIL() << "no error";
+  }
+  catch (const Error &e)
+  {
+    EXPECT_NE(std::string(e.what()).find("the blade moves 1e+09 m in one motion"),
+              std::string::npos)
+      << e.what();
+  }
+  EXPECT_EQ(f.mesh.n_tets(), n_tets);
+  f.expect_invariants("after the refused motion");
 }
 
 

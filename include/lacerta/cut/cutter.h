@@ -102,6 +102,14 @@ namespace lacerta::cut
       double max_advance   = 0.5;
     };
 
+    /**
+     * The most sweeps one blade motion may take. A motion that needs more (its length
+     * over `Maximum advance` times the element size around the blade) is a tool that
+     * jumps across the scene or tissue that has blown up around the blade: move_blade()
+     * stops with an error instead of sweeping for hours.
+     */
+    static constexpr double max_sweeps_per_motion = 1e5;
+
     /// Declares `subsection Cut`.
     static void
     declare_parameters(dealii::ParameterHandler &prm);
