@@ -7,6 +7,26 @@
 
 namespace lacerta::cut
 {
+  std::array<unsigned int, 4>
+  record_key(const TetCut &cut, const NodeRef &node)
+  {
+    std::array<unsigned int, 4> ids{};
+    if (node.kind == NodeKind::interior_point)
+    {
+      for (unsigned int m = 0; m < 4; ++m)
+        ids[m] = static_cast<unsigned int>(cut.vertex_ids[m]);
+      std::sort(ids.begin(), ids.end());
+    }
+    else
+    {
+      const PointKey key = point_key(cut.vertex_ids, node, 0);
+      for (unsigned int m = 0; m < 3; ++m)
+        ids[m] = static_cast<unsigned int>(key.ids[m]);
+    }
+    return ids;
+  }
+
+
   std::vector<std::vector<mesh::Tet>>
   recorded_children(const CutRecord &record)
   {
@@ -39,19 +59,8 @@ namespace lacerta::cut
             child[j] = t[n.index];
           else
           {
-            // The key of the point: the edge's, face's or tetrahedron's vertex ids,
-            // sorted, unused entries 0.
-            constexpr unsigned int      unused = ~0u;
-            std::array<unsigned int, 4> ids{{unused, unused, unused, unused}};
-            for (unsigned int v = 0; v < 4; ++v)
-              if (n.kind == NodeKind::edge_point
-                    ? (v == tet_edge_vertices[n.index][0]
-                       || v == tet_edge_vertices[n.index][1])
-                    : (n.kind == NodeKind::interior_point || v != n.index))
-                ids[v] = t[v];
-            std::sort(ids.begin(), ids.end());
-            std::replace(ids.begin(), ids.end(), unused, 0u);
-            const auto it = point_of.find({n.kind, ids});
+            const std::array<unsigned int, 4> ids = record_key(c, n);
+            const auto                        it  = point_of.find({n.kind, ids});
             if (it == point_of.end())
               throw_error("recorded_children: internal error, a point of split ",
                           k,

@@ -959,20 +959,7 @@ namespace lacerta::cut
             *slot = new_particle(p, parent, statistics);
             if (record)
             {
-              CutRecord::NewPoint point{*slot, n.kind, {}, p};
-              if (n.kind == NodeKind::interior_point)
-              {
-                for (unsigned int m = 0; m < 4; ++m)
-                  point.ids[m] = static_cast<unsigned int>(c.vertex_ids[m]);
-                std::sort(point.ids.begin(), point.ids.end());
-              }
-              else
-              {
-                const auto key = point_key(c.vertex_ids, n, parent);
-                for (unsigned int m = 0; m < 3; ++m)
-                  point.ids[m] = static_cast<unsigned int>(key.ids[m]);
-              }
-              record->new_points.push_back(point);
+              record->new_points.push_back({*slot, n.kind, record_key(c, n), p});
             }
             if (n.kind != NodeKind::interior_point)
             {

@@ -48,22 +48,27 @@ namespace lacerta::physics
      */
     template <typename ForEachNeighbour, typename RowSum, typename OnGift>
     double
-    borrow(ParticleSystem         &system,
-           const ForEachNeighbour &for_each_neighbour,
-           const RowSum           &row_sum,
-           const unsigned int      i,
-           const double            need,
-           const double            limit,
-           const unsigned int      reach,
-           std::vector<char>      &seen,
-           std::vector<double>    &spare,
-           const OnGift           &on_gift)
+    borrow(ParticleSystem            &system,
+           const ForEachNeighbour    &for_each_neighbour,
+           const RowSum              &row_sum,
+           const unsigned int         i,
+           const double               need,
+           const double               limit,
+           const unsigned int         reach,
+           std::vector<char>         &seen,
+           std::vector<double>       &spare,
+           std::vector<unsigned int> &donors,
+           std::vector<unsigned int> &first,
+           std::vector<unsigned int> &ring,
+           const OnGift              &on_gift)
     {
-      // The donors, ring by ring (ring r starts at first[r]), and what each can spare.
-      std::vector<unsigned int> donors, first = {0};
-      std::vector<unsigned int> ring = {i};
-      seen[i]                        = 1;
-      double available               = 0;
+      // The donors, ring by ring (ring r starts at first[r]), and what each can spare
+      // (the vectors are the caller's, kept between calls).
+      donors.clear();
+      first.assign(1, 0);
+      ring.assign(1, i);
+      seen[i]          = 1;
+      double available = 0;
       for (unsigned int hop = 0; hop < reach && available < need && !ring.empty(); ++hop)
       {
         for (const unsigned int p : ring)
@@ -395,6 +400,9 @@ namespace lacerta::physics
                reach,
                seen,
                spare,
+               donors,
+               ring_first,
+               ring,
                [&](const unsigned int d, const double m) { record_gift(d, i, m); });
       statistics.raised += moved > 0;
     }

@@ -71,6 +71,16 @@ namespace lacerta::cut
   };
 
   /**
+   * The key a record gives the point that node @p node of a child of split @p cut
+   * stands for (CutRecord::NewPoint::ids): the edge's two or the face's three vertex
+   * ids, or the split tetrahedron's four for an interior point, sorted, unused
+   * entries 0. The cutter records its new points under it and recorded_children()
+   * finds them by it.
+   */
+  std::array<unsigned int, 4>
+  record_key(const TetCut &cut, const NodeRef &node);
+
+  /**
    * The children the cutter made of every tetrahedron @p record replaced, in the cut
    * mesh's vertex ids: entry k lists those of `record.cuts[k]`, in the table's order.
    * They follow from the record alone (the table's split of each TetCut, with the

@@ -135,6 +135,8 @@ namespace lacerta::physics
     std::vector<std::uint8_t> in_region;
     std::vector<char>         seen;
     std::vector<double>       row_sum, spare;
+    /// The donors of one borrowing, ring by ring: where each ring starts, the ring.
+    std::vector<unsigned int> donors, ring_first, ring;
     unsigned int              stamp = 0;
     GershgorinRowScratch      scratch;
   };
