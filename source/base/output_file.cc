@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/output_file.h>
 
@@ -6,6 +7,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
+#include <fstream>
 #include <unistd.h>
 #include <utility>
 
@@ -97,6 +99,7 @@ namespace lacerta
   OutputFile::OutputFile(OutputFile &&other) noexcept
       : file_name(std::move(other.file_name))
       , descriptor(std::exchange(other.descriptor, -1))
+      , written(std::exchange(other.written, 0))
   {
   }
 
@@ -110,6 +113,7 @@ namespace lacerta
         ::close(descriptor);
       file_name  = std::move(other.file_name);
       descriptor = std::exchange(other.descriptor, -1);
+      written    = std::exchange(other.written, 0);
     }
     return *this;
   }
@@ -129,6 +133,41 @@ namespace lacerta
       throw_error("Cannot write '", file_name, "': the file is not open.");
     if (const int error = write_all(descriptor, text); error != 0)
       fail(file_name, error);
+    written += text.size();
+  }
+
+
+  void
+  OutputFile::serialize(Archive &archive)
+  {
+    if (descriptor < 0)
+      throw_error("Cannot write '", file_name, "': the file is not open.");
+    std::string contents;
+    if (!archive.loading())
+    {
+      // Read back what this object wrote: the file is written, never read, so its
+      // first `written` bytes are this object's.
+      std::ifstream in(file_name, std::ios::binary);
+      contents.resize(written);
+      if (!in.read(contents.data(), static_cast<std::streamsize>(written)))
+        throw_error("Checkpoint: cannot read back '",
+                    file_name,
+                    "' (",
+                    written,
+                    " bytes written so far): it was changed or removed during the run.");
+    }
+    archive &contents;
+    if (archive.loading())
+    {
+      int error = 0;
+      if (::ftruncate(descriptor, 0) != 0 || ::lseek(descriptor, 0, SEEK_SET) != 0)
+        error = errno;
+      if (error == 0)
+        error = write_all(descriptor, contents);
+      if (error != 0)
+        fail(file_name, error);
+      written = contents.size();
+    }
   }
 
 

@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/cut/boundary_face_tree.h>
 
 #include <algorithm>
@@ -398,5 +399,19 @@ namespace lacerta::cut
       [&](const Box &b)
       { return b.overlaps(all) && (b.meets(triangles[0]) || b.meets(triangles[1])); },
       hits);
+  }
+
+
+  void
+  BoundaryFaceTree::Tree::serialize(Archive &archive)
+  {
+    archive(faces, nodes);
+  }
+
+
+  void
+  BoundaryFaceTree::serialize(Archive &archive)
+  {
+    archive(boundary, added, extra, vertices, fitted, slot, inflation);
   }
 } // namespace lacerta::cut

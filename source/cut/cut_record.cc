@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/cut/cut_record.h>
 
@@ -76,5 +77,12 @@ namespace lacerta::cut
       }
     }
     return result;
+  }
+
+
+  void
+  CutRecord::serialize(Archive &archive)
+  {
+    archive(cuts, snap_fraction, new_points, vertex_choices);
   }
 } // namespace lacerta::cut

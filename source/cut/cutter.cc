@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/cut/cutter.h>
 #include <lacerta/cut/predicates.h>
@@ -1212,5 +1213,15 @@ namespace lacerta::cut
       on_surface[v] = 1;
       on_surface_list.push_back(v);
     }
+  }
+
+
+  void
+  Cutter::serialize(Archive &archive)
+  {
+    // What a blade motion leaves for the next one; the rest is scratch of a motion.
+    archive.section("cutter");
+    archive(current, typical_edge, tree, active, on_surface, on_surface_list);
+    archive(side_records, blade_cell_positions, stroke, crossings, crossings_at, adopted);
   }
 } // namespace lacerta::cut

@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/cut/lacerator.h>
 #include <lacerta/physics/particle_system.h>
@@ -393,14 +394,7 @@ namespace lacerta::cut
     if (!l.cutter)
     {
       // A new laceration, or a stopped one whose particle system was replaced.
-      l.cutter = std::make_shared<Cutter>(mesh,
-                                          system,
-                                          density,
-                                          youngs_modulus,
-                                          integral_of_density,
-                                          cut_parameters,
-                                          blade_at(l, from));
-      l.cutter->set_recorder(recorder);
+      l.cutter = make_cutter(l, from);
       // A stopped laceration continued on a new particle system: its particles on its
       // plane (the opened crack, and the points where the MT closed it inside the cells
       // at its tip) are the new cutter's crack, so that the cells behind the tip open
@@ -635,5 +629,44 @@ namespace lacerta::cut
       s.torn = false;
     s.update_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     return s;
+  }
+
+
+  std::shared_ptr<Cutter>
+  Lacerator::make_cutter(const Laceration &l, const double along)
+  {
+    auto cutter = std::make_shared<Cutter>(mesh,
+                                           system,
+                                           density,
+                                           youngs_modulus,
+                                           integral_of_density,
+                                           cut_parameters,
+                                           blade_at(l, along));
+    cutter->set_recorder(recorder);
+    return cutter;
+  }
+
+
+  void
+  Lacerator::serialize(Archive &archive)
+  {
+    archive.section("lacerator");
+    archive(surface, surface_valid, sheet, tears, typical_edge);
+    std::size_t n = lacerations.size();
+    archive    &n;
+    lacerations.resize(archive.size(n, 1));
+    for (Laceration &l : lacerations)
+    {
+      archive(l.origin, l.normal, l.advance, l.across, l.edge, l.stop, l.end, l.complete);
+      archive(l.across_lo, l.across_hi, l.created_rest);
+      // A laceration that may continue keeps its cutter's state (its stroke, its
+      // decided crossings); the cutter is made on the loaded mesh, then given it.
+      bool     has_cutter = l.cutter != nullptr;
+      archive &has_cutter;
+      if (archive.loading())
+        l.cutter = has_cutter ? make_cutter(l, l.stop) : nullptr;
+      if (l.cutter)
+        l.cutter->serialize(archive);
+    }
   }
 } // namespace lacerta::cut

@@ -3,6 +3,7 @@
 // solved for static equilibrium at given times on the mesh of that time (after cuts,
 // the cut mesh).
 
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/output_file.h>
 #include <lacerta/base/parameter_utilities.h>
@@ -305,6 +306,18 @@ namespace lacerta::fem
             std::cout << " " << springs[i] << "/" << fem[i];
           std::cout << "\n";
         }
+      }
+
+      /// Not resumable: the FEM reference's time integration lives in Trilinos
+      /// vectors that a checkpoint does not hold.
+      void
+      serialize(Archive &) override
+      {
+        throw_error("Checkpoint: the 'fem comparison' postprocessor cannot be "
+                    "checkpointed (its FEM reference is integrated in Trilinos vectors "
+                    "a checkpoint does not hold); remove it from 'Postprocess/List' or "
+                    "set 'Checkpoint/Steps between checkpoints' and 'Checkpoint/Seconds "
+                    "between checkpoints' to 0.");
       }
 
       SolverParameters                  parameters;

@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/mesh/tet_mesh.h>
 
@@ -925,5 +926,14 @@ namespace lacerta::mesh
       }
       boundary_vertex[v] = on_boundary;
     }
+  }
+
+
+  void
+  TetMesh::serialize(Archive &archive)
+  {
+    archive.section("mesh");
+    archive(vertices, tets, neighbors, edges, tet_edge_ids, boundary_faces);
+    archive(boundary_vertex, source_name, vertex_tets, boundary_slot, edge_uses);
   }
 } // namespace lacerta::mesh

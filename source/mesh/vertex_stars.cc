@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/mesh/vertex_stars.h>
 
@@ -122,5 +123,12 @@ namespace lacerta::mesh
       list.clear();
       free_overflow.push_back(index);
     }
+  }
+
+
+  void
+  VertexStars::serialize(Archive &archive)
+  {
+    archive(slot_words, lines_per_slot, n_vertices, lines, overflow, free_overflow);
   }
 } // namespace lacerta::mesh

@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/mt/lod.h>
 #include <lacerta/mt/lod_query.h>
 
@@ -436,5 +437,22 @@ namespace lacerta::mt
         return {best, best_coordinates};
       j = parent;
     }
+  }
+
+
+  void
+  Lod::serialize(Archive &archive, const LodQuery &query)
+  {
+    archive.section("level of detail");
+    archive(applied, changed, changed_list, position, active, active_coarse, active_fine);
+    archive(need_stamp, need_value, need_until, travel, children_begin, children);
+    archive(frontier, frontier_position, joined, checks, check_at, cut_updates_seen);
+    archive(stamp, n_last_applied, n_last_undone);
+    // The identity of a query is that of an object of this process: what is kept is
+    // whether the last extraction answered the query it is given now.
+    bool     current = query_identity == query.identity();
+    archive &current;
+    if (archive.loading())
+      query_identity = current ? query.identity() : 0;
   }
 } // namespace lacerta::mt

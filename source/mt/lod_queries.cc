@@ -1,5 +1,6 @@
 // The level of detail queries: `uniform` and `focus`.
 
+#include <lacerta/base/archive.h>
 #include <lacerta/mt/lod_query.h>
 
 #include <algorithm>
@@ -70,6 +71,12 @@ namespace lacerta::mt
         return std::numeric_limits<double>::infinity();
       }
 
+      /// Nothing: the query has no focus.
+      void
+      serialize(Archive &) override
+      {
+      }
+
     private:
       double error = 0;
     };
@@ -122,6 +129,13 @@ namespace lacerta::mt
       focus_travel() const override
       {
         return travel;
+      }
+
+      /// The focus and the distance it travelled.
+      void
+      serialize(Archive &archive) override
+      {
+        archive(focus, travel);
       }
 
       double

@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/mt/mt_cutter.h>
 
@@ -208,5 +209,12 @@ namespace lacerta::mt
     statistics.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return statistics;
+  }
+
+
+  void
+  MtCutter::serialize(Archive &archive)
+  {
+    archive &vertex_tets;
   }
 } // namespace lacerta::mt

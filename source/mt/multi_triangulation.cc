@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/mt/multi_triangulation.h>
 
@@ -95,5 +96,15 @@ namespace lacerta::mt
       if (!(mesh::signed_volume(vertices[a], vertices[b], vertices[c], vertices[d]) > 0))
         throw_error("Multi-Triangulation '", source, "': tet ", t, " is inverted.");
     }
+  }
+
+
+  void
+  MultiTriangulation::serialize(Archive &archive)
+  {
+    archive.section("multi-triangulation");
+    archive(vertices, tets, creator, destroyer, fine_begin, coarse_begin, coarse_list);
+    archive(node_vertex, vertex_node, error, ball, cut_fine, cut_coarse, replaced);
+    archive(cut_origin, cut_pin, n_cut_updates, own_error, own_ball);
   }
 } // namespace lacerta::mt

@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/parameter_utilities.h>
 #include <lacerta/base/parsed_function.h>
@@ -343,5 +344,22 @@ namespace lacerta::mt
         << mesh.n_vertices() << " particles (" << change[0] << " nodes applied, "
         << change[1] << " undone; " << n_new << " particles interpolated), mass "
         << total_mass << " kg\n";
+  }
+
+
+  void
+  Multiresolution::serialize(Archive &archive)
+  {
+    archive.section("multiresolution");
+    archive(mt, *query, last_focus, last_step, mesh, vertices, n_kept, n_new);
+    lod->serialize(archive, *query);
+    bool     has_mt_cutter = mt_cutter != nullptr;
+    archive &has_mt_cutter;
+    if (archive.loading() && has_mt_cutter && !mt_cutter)
+      mt_cutter = std::make_unique<MtCutter>(mt);
+    if (archive.loading() && !has_mt_cutter)
+      mt_cutter.reset();
+    if (mt_cutter)
+      mt_cutter->serialize(archive);
   }
 } // namespace lacerta::mt

@@ -1,6 +1,7 @@
 // Force model `corotated fem`: explicit corotated linear elasticity on the P1
 // tetrahedra (Müller and Gross 2004), with the masses of Section 3.1.
 
+#include <lacerta/base/archive.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/assembly.h>
 #include <lacerta/physics/force_model.h>
@@ -301,6 +302,15 @@ namespace lacerta::physics
         return rotated;
       }
 
+    public:
+      /// The ranges and the copies of the tetrahedra in them.
+      void
+      serialize(Archive &archive) override
+      {
+        archive(ranges, tets);
+      }
+
+    private:
       double          nu = 0.25;
       ParticleRanges  ranges;
       PartitionedTets tets;

@@ -1,5 +1,6 @@
 // Force model `linear springs`: the paper's springs, f = k (|d| - L0) d/|d|.
 
+#include <lacerta/base/archive.h>
 #include <lacerta/physics/linear_springs.h>
 #include <lacerta/physics/particle_system.h>
 
@@ -354,4 +355,16 @@ namespace lacerta::physics
     "linear springs",
     "The paper's springs (Section 3): force k (L - L0) along the "
     "spring, with the optional damping along springs.");
+
+
+  void
+  LinearSprings::serialize(Archive &archive)
+  {
+    archive(ranges, holders, known_springs, stiffness_scale);
+    std::size_t n = segments.size();
+    archive    &n;
+    segments.resize(archive.size(n, 1));
+    for (Segment &segment : segments)
+      archive(segment.set, segment.origin);
+  }
 } // namespace lacerta::physics

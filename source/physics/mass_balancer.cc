@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/mass_balancer.h>
@@ -428,5 +429,14 @@ namespace lacerta::physics
     statistics.moved      = positive_shift;
     statistics.unresolved = n_unresolved;
     return statistics;
+  }
+
+
+  void
+  MassBalancer::serialize(Archive &archive)
+  {
+    archive.section("mass balancer");
+    archive(target_lambda, reach, positive_shift, n_unresolved, unresolved);
+    archive(gifts, gifts_of, n_live_gifts);
   }
 } // namespace lacerta::physics

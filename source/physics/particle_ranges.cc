@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/physics/particle_ranges.h>
 #include <lacerta/physics/particle_system.h>
 
@@ -85,5 +86,12 @@ namespace lacerta::physics
         a[3 * i + d] =
           keep * ((a[3 * i + d] + ext[3 * i + d]) * m_inv + g[d] - c * v[3 * i + d]);
     }
+  }
+
+
+  void
+  ParticleRanges::serialize(Archive &archive)
+  {
+    archive(first_particle, inverse_mass, n_threads);
   }
 } // namespace lacerta::physics

@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/physics/force_model.h>
 #include <lacerta/physics/particle_system.h>
 
@@ -179,5 +180,24 @@ namespace lacerta::physics
   ParticleSystem::elastic_energy() const
   {
     return forces->elastic_energy(*this, position.data());
+  }
+
+
+  void
+  SpringSet::serialize(Archive &archive)
+  {
+    archive(a, b, stiffness, rest_length);
+  }
+
+
+  void
+  ParticleSystem::serialize(Archive &archive)
+  {
+    archive.section("particle system");
+    archive(position, velocity, mass, mass_shift, free, external_force, springs);
+    archive(body_acceleration, mass_damping, spring_damping, poisson_ratio, rest);
+    archive(force_threads, changed, listed, all_changed);
+    archive.section("force model");
+    forces->serialize(archive);
   }
 } // namespace lacerta::physics

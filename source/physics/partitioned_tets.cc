@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/assembly.h>
@@ -253,5 +254,22 @@ namespace lacerta::physics
       for (const unsigned int v : tet)
         ++count[v];
     return count;
+  }
+
+
+  void
+  PartitionedTets::serialize(Archive &archive)
+  {
+    std::size_t n = parts.size();
+    archive    &n;
+    parts.resize(archive.size(n, 1));
+    for (Part &part : parts)
+      archive(part.vertex,
+              part.owned,
+              part.tet,
+              part.rest_volume,
+              part.youngs_modulus,
+              part.rest_inverse);
+    archive(copies, seen, update_count);
   }
 } // namespace lacerta::physics

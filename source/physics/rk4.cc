@@ -1,5 +1,6 @@
 // Integrator `rk4`: the classical fourth-order Runge-Kutta method the paper uses.
 
+#include <lacerta/base/archive.h>
 #include <lacerta/physics/integrator.h>
 #include <lacerta/physics/particle_system.h>
 
@@ -92,6 +93,12 @@ namespace lacerta::physics
       n_evaluations_per_step() const override
       {
         return 4;
+      }
+
+      /// Nothing: every step starts from the positions and velocities alone.
+      void
+      serialize(Archive &) override
+      {
       }
 
     private:

@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/single_evaluation_integrator.h>
 
@@ -22,5 +23,12 @@ namespace lacerta::physics
   SingleEvaluationIntegrator::n_evaluations_per_step() const
   {
     return 1;
+  }
+
+
+  void
+  SingleEvaluationIntegrator::serialize(Archive &archive)
+  {
+    archive &acceleration;
   }
 } // namespace lacerta::physics

@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/force_model.h>
@@ -649,5 +650,14 @@ namespace lacerta::physics
     // changes (a stroke changes the system at every step) accumulated that loss into
     // false alarms.
     start_ledger(system);
+  }
+
+
+  void
+  BlowUpMonitor::serialize(Archive &archive)
+  {
+    archive.section("blow-up monitor");
+    archive(pending_change, tolerance, initial_energy, energy_scale, energy_floor, work);
+    archive(previous_position, previous_load, load);
   }
 } // namespace lacerta::physics

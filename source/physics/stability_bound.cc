@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/stability_bound.h>
@@ -120,5 +121,13 @@ namespace lacerta::physics
     if (std::isnan(lambda[a]) || std::isnan(lambda[b]))
       return std::isnan(lambda[a]) && (!std::isnan(lambda[b]) || a < b);
     return lambda[a] > lambda[b] || (lambda[a] == lambda[b] && a < b);
+  }
+
+
+  void
+  StabilityBound::serialize(Archive &archive)
+  {
+    archive.section("stability bound");
+    archive(lambda, stiffest, tree, leaves);
   }
 } // namespace lacerta::physics

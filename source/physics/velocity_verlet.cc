@@ -1,5 +1,6 @@
 // Integrator `velocity_verlet`: the second-order symplectic leapfrog.
 
+#include <lacerta/base/archive.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/single_evaluation_integrator.h>
 
@@ -60,6 +61,14 @@ namespace lacerta::physics
           omega, modal_damping(omega, mass_damping, spring_damping));
       }
 
+
+      /// The accelerations at the current positions, and whether they are current.
+      void
+      serialize(Archive &archive) override
+      {
+        SingleEvaluationIntegrator::serialize(archive);
+        archive &acceleration_is_current;
+      }
 
       bool acceleration_is_current = false;
     };

@@ -2,6 +2,7 @@
 // term per tetrahedron, so that the pair reproduces Young's modulus and the Poisson
 // ratio.
 
+#include <lacerta/base/archive.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/linear_springs.h>
 #include <lacerta/physics/matrix3.h>
@@ -431,6 +432,16 @@ namespace lacerta::physics
         return K;
       }
 
+    public:
+      /// The springs' partition and the copies of the tetrahedra.
+      void
+      serialize(Archive &archive) override
+      {
+        LinearSprings::serialize(archive);
+        archive &tets;
+      }
+
+    private:
       double                 lattice_nu = 0.25;
       VolumeSpringParameters parameters;
       PartitionedTets        tets;

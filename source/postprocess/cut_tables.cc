@@ -1,6 +1,7 @@
 // Postprocessor `cut tables`: the paper's Tables 1 and 2 and the log of the tears, on
 // the screen.
 
+#include <lacerta/base/archive.h>
 #include <lacerta/cut/cutter.h>
 #include <lacerta/cut/invariants.h>
 #include <lacerta/cut/lacerator.h>
@@ -172,6 +173,13 @@ namespace lacerta::postprocess
         for (const double v : pieces)
           std::cout << " " << v;
         std::cout << "\n";
+      }
+
+      /// The tables' sums so far.
+      void
+      serialize(Archive &archive) override
+      {
+        archive(table1, stroke, table2, tears);
       }
 
       const scene::Scene *scene     = nullptr;

@@ -1,5 +1,6 @@
 // Postprocessor `png`: pictures of the run, rendered offscreen with VTK.
 
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/output_file.h>
 #include <lacerta/base/parameter_utilities.h>
@@ -182,6 +183,13 @@ namespace lacerta::postprocess
                       count,
                       " numbers separated by commas (or empty).");
         return values;
+      }
+
+      /// The schedule and the pictures written so far.
+      void
+      serialize(Archive &archive) override
+      {
+        archive(schedule, n_written);
       }
 
       OutputSchedule                       schedule;

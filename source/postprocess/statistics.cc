@@ -1,5 +1,6 @@
 // Postprocessor `statistics`: one row per step in statistics.csv.
 
+#include <lacerta/base/archive.h>
 #include <lacerta/base/output_file.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/postprocess/postprocessor.h>
@@ -76,6 +77,13 @@ namespace lacerta::postprocess
         file.append(
           std::string_view(line,
                            std::min(static_cast<std::size_t>(length), sizeof(line) - 1)));
+      }
+
+      /// The table written so far.
+      void
+      serialize(Archive &archive) override
+      {
+        archive &file;
       }
 
     private:

@@ -1,5 +1,6 @@
 // Postprocessor `vtu`: VTU files and a PVD time series for ParaView.
 
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/output_file.h>
 #include <lacerta/mesh/tet_mesh.h>
@@ -130,6 +131,13 @@ namespace lacerta::postprocess
               << file << "\"/>\n";
         pvd << "  </Collection>\n</VTKFile>\n";
         write_file_atomically(directory + "/solution.pvd", pvd.str());
+      }
+
+      /// The schedule and the series written so far.
+      void
+      serialize(Archive &archive) override
+      {
+        archive(schedule, n_written, series);
       }
 
       OutputSchedule                              schedule;

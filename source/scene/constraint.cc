@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/scene/constraint.h>
@@ -114,5 +115,12 @@ namespace lacerta::scene
     }
     prm.leave_subsection();
     return constraints;
+  }
+
+
+  void
+  Constraint::serialize(Archive &archive)
+  {
+    archive &particles;
   }
 } // namespace lacerta::scene

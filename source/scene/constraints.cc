@@ -1,5 +1,6 @@
 // Constraint plugins: fixed, moving handle, force handle.
 
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/parsed_function.h>
 #include <lacerta/physics/particle_system.h>
@@ -182,6 +183,14 @@ namespace lacerta::scene
         for (const unsigned int i : particles)
           for (unsigned int d = 0; d < 3; ++d)
             system.external_force[3 * i + d] += value[d] * system.mass[i] / total_mass;
+      }
+
+      /// The particles, their total mass and their rest centroid.
+      void
+      serialize(Archive &archive) override
+      {
+        Constraint::serialize(archive);
+        archive(centroid, total_mass);
       }
 
     private:

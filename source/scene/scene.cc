@@ -1,3 +1,4 @@
+#include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/cut/cutter.h>
 #include <lacerta/cut/invariants.h>
@@ -394,5 +395,20 @@ namespace lacerta::scene
         return "the re-extraction of the level of detail";
     }
     return "a change of the particle system";
+  }
+
+
+  void
+  Scene::serialize(Archive &archive)
+  {
+    // The mesh and the particle system first: the cutters are made on them.
+    archive.section("scene");
+    archive(
+      mesh, integral_of_density, initial_volume, level_of_detail_volume, cut_records);
+    archive(multiresolution, *system);
+    archive.section("constraints");
+    for (auto &constraint : constraints)
+      constraint->serialize(archive);
+    archive(cutter, lacerator);
   }
 } // namespace lacerta::scene

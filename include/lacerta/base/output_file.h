@@ -5,11 +5,14 @@
  */
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <string_view>
 
 namespace lacerta
 {
+  class Archive;
+
   /**
    * Creates @p directory and its parents if they do not exist; an Error names the
    * directory (as `Output directory`) and the system's reason if that fails.
@@ -82,8 +85,19 @@ namespace lacerta
     const std::string &
     name() const;
 
+    /**
+     * Writes the file's contents so far into a checkpoint, or, when @p archive loads,
+     * replaces what the file holds by the contents the checkpoint kept, so that the
+     * rows written after the checkpoint are gone and the next append follows the
+     * last row it kept.
+     */
+    void
+    serialize(Archive &archive);
+
   private:
     std::string file_name;
     int         descriptor = -1;
+    /// Bytes appended since the file was created.
+    std::size_t written = 0;
   };
 } // namespace lacerta

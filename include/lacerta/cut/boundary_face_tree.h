@@ -10,6 +10,10 @@
 
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::cut
 {
   /**
@@ -103,6 +107,10 @@ namespace lacerta::cut
     static std::array<Point, 3>
     triangle(const Face &f, const double *x);
 
+    /// Writes or reads the state for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
+
   private:
     struct Node
     {
@@ -116,6 +124,10 @@ namespace lacerta::cut
     {
       std::vector<Face> faces;
       std::vector<Node> nodes;
+
+      /// Writes or reads the tree for a checkpoint.
+      void
+      serialize(Archive &archive);
     };
 
     /// A face while a tree is built: its box and its centroid (times 3).

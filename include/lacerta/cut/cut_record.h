@@ -13,6 +13,10 @@
 #include <cstdint>
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::cut
 {
   /**
@@ -68,6 +72,10 @@ namespace lacerta::cut
     std::vector<NewPoint> new_points;
     /// The vertex every child uses at each of its nodes on the cut.
     std::vector<VertexChoice> vertex_choices;
+
+    /// Writes or reads the record for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
   };
 
   /**

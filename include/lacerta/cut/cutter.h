@@ -33,6 +33,10 @@ namespace lacerta::physics
   class ParticleSystem;
 }
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::cut
 {
   /// Boundary id of the faces a cut opens (the two sheets of the crack).
@@ -176,6 +180,10 @@ namespace lacerta::cut
     {
       return active;
     }
+
+    /// Writes or reads the state for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
 
   private:
     /**

@@ -28,6 +28,10 @@ namespace lacerta::physics
   class ParticleSystem;
 }
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::cut
 {
   /**
@@ -161,6 +165,10 @@ namespace lacerta::cut
       return tears;
     }
 
+    /// Writes or reads the state for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
+
   private:
     /// A spring on the surface, with its limit.
     struct SurfaceSpring
@@ -234,6 +242,10 @@ namespace lacerta::cut
      */
     void
     advance(unsigned int l, double from, double forced, LacerationStatistics &s);
+
+    /// A cutter for laceration @p l, its blade where the front is at @p along.
+    std::shared_ptr<Cutter>
+    make_cutter(const Laceration &l, double along);
 
     /// Starts a laceration at surface spring @p seed.
     void

@@ -13,6 +13,10 @@
 #include <utility>
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::mesh
 {
   /// The four vertex ids of a tetrahedron, positively oriented.
@@ -323,6 +327,10 @@ namespace lacerta::mesh
                  const std::vector<std::array<unsigned int, 4>> &face_boundary_ids,
                  std::vector<unsigned int>                      &added_ids,
                  EdgeUpdate                                     &edge_update);
+
+    /// Writes or reads the state for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
 
   private:
     /// Working arrays of replace_tets(), kept so that an update allocates nothing

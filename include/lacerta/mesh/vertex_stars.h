@@ -8,6 +8,10 @@
 #include <cstddef>
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::mesh
 {
   /**
@@ -181,6 +185,10 @@ namespace lacerta::mesh
       }
       s[0] = kept;
     }
+
+    /// Writes or reads the state for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
 
   private:
     /// erase_marked() for a star in the overflow list.

@@ -12,6 +12,10 @@
 #include <cstdint>
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::mt
 {
   class LodQuery;
@@ -113,6 +117,13 @@ namespace lacerta::mt
      */
     std::pair<std::uint32_t, std::array<double, 4>>
     locate_in_previous(std::uint32_t v) const;
+
+    /**
+     * Writes or reads the state for a checkpoint (see lacerta::Archive); @p query is
+     * the query of the last extraction, whose identity the loaded state keeps.
+     */
+    void
+    serialize(Archive &archive, const LodQuery &query);
 
   private:
     void

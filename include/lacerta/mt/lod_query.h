@@ -10,6 +10,10 @@
 #include <cstdint>
 #include <string>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::mt
 {
   /**
@@ -45,6 +49,10 @@ namespace lacerta::mt
      */
     virtual double
     focus_travel() const;
+
+    /// Writes or reads the query's state (the focus) for a checkpoint.
+    virtual void
+    serialize(Archive &archive) = 0;
 
     /**
      * A distance the focus may travel, from where it is now, before

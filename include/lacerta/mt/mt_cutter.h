@@ -14,6 +14,10 @@
 #include <cstdint>
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::mt
 {
   /**
@@ -70,6 +74,10 @@ namespace lacerta::mt
     apply(const std::vector<cut::CutRecord> &records,
           std::vector<std::uint32_t>        &mt_vertex_of,
           Lod                               &lod);
+
+    /// Writes or reads the state for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
 
   private:
     /// The live MT tet with vertices @p ids (any order), active in @p lod.

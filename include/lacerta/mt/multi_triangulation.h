@@ -12,6 +12,10 @@
 #include <string>
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::mt
 {
   /**
@@ -206,5 +210,9 @@ namespace lacerta::mt
      */
     void
     check(const std::string &source) const;
+
+    /// Writes or reads the state for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
   };
 } // namespace lacerta::mt

@@ -32,6 +32,10 @@ namespace lacerta::cut
   struct Blade;
 }
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::mt
 {
   /**
@@ -157,6 +161,10 @@ namespace lacerta::mt
      */
     mesh::Point3
     focus_of_blade(const cut::Blade &blade) const;
+
+    /// Writes or reads the state for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
 
   private:
     /// Rebuilds the mesh and the vertex list from the Lod.

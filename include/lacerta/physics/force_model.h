@@ -12,6 +12,10 @@
 #include <string>
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::physics
 {
   class ParticleSystem;
@@ -95,6 +99,10 @@ namespace lacerta::physics
      */
     virtual double
     spring_stiffness_scale() const;
+
+    /// Writes or reads the model's state for a checkpoint (see lacerta::Archive).
+    virtual void
+    serialize(Archive &archive) = 0;
 
     /// A 12x12 tangent stiffness of a tetrahedron, rows and columns ordered (local
     /// vertex, component), row-major.

@@ -9,6 +9,10 @@
 #include <memory>
 #include <string>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::physics
 {
   class ParticleSystem;
@@ -60,6 +64,14 @@ namespace lacerta::physics
     /// Number of acceleration evaluations per step (for throughput figures).
     virtual unsigned int
     n_evaluations_per_step() const = 0;
+
+    /**
+     * Writes or reads what the integrator carries from one step to the next, for a
+     * checkpoint (see lacerta::Archive); scratch space that every step overwrites is
+     * not part of it.
+     */
+    virtual void
+    serialize(Archive &archive) = 0;
 
     /// Declares `subsection Integrator` with the `Scheme` selector.
     static void

@@ -86,6 +86,10 @@ namespace lacerta::physics
     void
     set_stiffness_scale(double scale);
 
+    /// The springs' partition into the threads' ranges.
+    void
+    serialize(Archive &archive) override;
+
     /// The particle ranges of the threads.
     ParticleRanges ranges;
 

@@ -10,6 +10,10 @@
 #include <cstdint>
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::physics
 {
   class ParticleSystem;
@@ -93,6 +97,10 @@ namespace lacerta::physics
     /// How far above the target a donor's bound may rise: a time step 1.41 times
     /// shorter at most, under the 1.5 times the cost per tetrahedron a cut may add.
     static constexpr double donor_headroom = 2.0;
+
+    /// Writes or reads the state for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
 
   private:
     double       target_lambda;

@@ -13,6 +13,10 @@
 #include <memory>
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::physics
 {
   class ParticleSystem;
@@ -119,6 +123,10 @@ namespace lacerta::physics
             tbb::static_partitioner());
         });
     }
+
+    /// Writes or reads the ranges for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
 
   private:
     /// Range p is [first_particle[p], first_particle[p + 1]).

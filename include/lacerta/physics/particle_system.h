@@ -17,6 +17,10 @@ namespace dealii
   class Function;
 }
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::mesh
 {
   class TetMesh;
@@ -208,6 +212,10 @@ namespace lacerta::physics
     /// Elastic energy of the springs at the current positions.
     double
     elastic_energy() const;
+
+    /// Writes or reads the state for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
 
     /// Rest positions the system was created with.
     const std::vector<double> &

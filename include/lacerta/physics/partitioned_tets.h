@@ -9,6 +9,10 @@
 #include <array>
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::mesh
 {
   class TetMesh;
@@ -184,6 +188,10 @@ namespace lacerta::physics
     /// The number of tetrahedra of every particle (the load to balance ranges by).
     static std::vector<std::size_t>
     tets_per_particle(const ParticleSystem &system);
+
+    /// Writes or reads the copies for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
 
   private:
     /// Where a copy is: its range and its index there.

@@ -29,6 +29,10 @@ namespace lacerta::physics
     unsigned int
     n_evaluations_per_step() const override;
 
+    /// The accelerations of the last evaluation.
+    void
+    serialize(Archive &archive) override;
+
   protected:
     /// Accelerations of the current evaluation, 3 per particle.
     std::vector<double> acceleration;

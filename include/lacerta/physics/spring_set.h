@@ -7,6 +7,10 @@
 #include <cstddef>
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::physics
 {
   /**
@@ -65,6 +69,10 @@ namespace lacerta::physics
     }
 
     /// Removes all springs.
+    /// Writes or reads the state for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
+
     void
     clear()
     {

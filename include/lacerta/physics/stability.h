@@ -8,6 +8,10 @@
 #include <string>
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::physics
 {
   class ParticleSystem;
@@ -198,6 +202,10 @@ namespace lacerta::physics
     {
       return work;
     }
+
+    /// Writes or reads the state for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
 
   private:
     /// Fills `load` with the force each load exerts on the particles at @p system's

@@ -8,6 +8,10 @@
 
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::physics
 {
   class ParticleSystem;
@@ -51,6 +55,10 @@ namespace lacerta::physics
     {
       return lambda[i];
     }
+
+    /// Writes or reads the state for a checkpoint (see lacerta::Archive).
+    void
+    serialize(Archive &archive);
 
   private:
     /// Builds the tree of maxima over `lambda`, with room for at least @p n

@@ -10,6 +10,10 @@
 #include <string>
 #include <vector>
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::mesh
 {
   class TetMesh;
@@ -127,6 +131,14 @@ namespace lacerta::postprocess
     /// Called once when the run ends, with the last state (summaries).
     virtual void
     finish(const RunState &state);
+
+    /**
+     * Writes or reads what the postprocessor has gathered or written so far, for a
+     * checkpoint (see lacerta::Archive): after a resume it goes on as if the run had
+     * not stopped. An Error if it cannot be resumed.
+     */
+    virtual void
+    serialize(Archive &archive) = 0;
 
     /// Declares `subsection Postprocess` with the list and every plugin's subsection.
     static void

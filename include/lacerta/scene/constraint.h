@@ -18,6 +18,10 @@ namespace lacerta::physics
   class ParticleSystem;
 }
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::scene
 {
   class Region;
@@ -79,6 +83,14 @@ namespace lacerta::scene
     /// forces.
     virtual void
     add_forces(double t, physics::ParticleSystem &system) const;
+
+    /**
+     * Writes or reads what the constraint has learnt during the run, for a checkpoint
+     * (see lacerta::Archive): its particles (cuts add copies) and what it derived from
+     * them.
+     */
+    virtual void
+    serialize(Archive &archive);
 
     /// The instance's name in the parameter file.
     std::string name;

@@ -35,6 +35,10 @@ namespace lacerta::cut
   struct LacerationStatistics;
 } // namespace lacerta::cut
 
+namespace lacerta
+{
+  class Archive;
+}
 namespace lacerta::scene
 {
   /// What Scene::update_multiresolution_after_cut() did.
@@ -156,6 +160,15 @@ namespace lacerta::scene
     /// Recomputes the external forces at time @p t (only if some load varies).
     void
     update_loads(double t);
+
+    /**
+     * Writes or reads the scene's state for a checkpoint (see lacerta::Archive): the
+     * mesh with its cuts, the multiresolution model, the particle system, the
+     * constraints, the cutter and the lacerator. A scene built from the same parameters
+     * then goes on exactly as the one that wrote it.
+     */
+    void
+    serialize(Archive &archive);
 
     /// Writes a description of the scene (sizes, mass, stiffness range, constraints).
     void
