@@ -1,3 +1,5 @@
+#include <lacerta/base/archive.h>
+#include <lacerta/base/checkpoint_file.h>
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/input_path.h>
 #include <lacerta/base/output_file.h>
@@ -214,6 +216,37 @@ namespace lacerta
                       "How many springs away 'Mass redistribution' may take mass from.");
     prm.leave_subsection();
 
+    prm.enter_subsection("Checkpoint");
+    prm.declare_entry(
+      "Steps between checkpoints",
+      "0",
+      dealii::Patterns::Integer(0, 1000000000),
+      "Write a checkpoint (<Output directory>/checkpoint.lcp, the one before it kept as "
+      "checkpoint.lcp.previous) every this many steps; 0: never by steps.");
+    prm.declare_entry(
+      "Seconds between checkpoints",
+      "0",
+      dealii::Patterns::Double(0.0, 1e7),
+      "Write a checkpoint after the first step that ends this much wall time after "
+      "the last one (or the start) [s]; 0: never by wall time.");
+    prm.declare_entry(
+      "Resume",
+      "false",
+      dealii::Patterns::Bool(),
+      "Continue the run from the last checkpoint in 'Output directory' (from the "
+      "previous one if the last is damaged) instead of from the start. The parameters "
+      "must be those the checkpoint was written with, but for 'End time', 'Output "
+      "directory' and this subsection; the run then ends exactly as if it had never "
+      "stopped.");
+    prm.declare_entry(
+      "Stop after steps",
+      "0",
+      dealii::Patterns::Integer(0, 1000000000),
+      "End the run after this many steps (a resumed run counts from its start at "
+      "time 0), with a checkpoint, as a batch job with a time limit would; 0: run to "
+      "'End time'.");
+    prm.leave_subsection();
+
     scene::Scene::declare_parameters(prm, constraint_names);
     physics::Integrator::declare_parameters(prm);
     postprocess::Postprocessor::declare_parameters(prm);
@@ -257,6 +290,19 @@ namespace lacerta
       names.push_back("<name>");
     declare_parameters(prm, names);
     parse(prm, false);
+
+    prm.enter_subsection("Checkpoint");
+    const bool checkpoints = prm.get_integer("Steps between checkpoints") > 0
+                             || prm.get_double("Seconds between checkpoints") > 0
+                             || prm.get_bool("Resume")
+                             || prm.get_integer("Stop after steps") > 0;
+    prm.leave_subsection();
+    if (checkpoints && prm.get("Mode") == "study")
+      throw_error("Parameter file '",
+                  file,
+                  "': 'subsection Checkpoint' applies to "
+                  "'Mode = simulation'; a study ('Mode = study') runs its variants "
+                  "from the start and cannot be checkpointed.");
   }
 
 
@@ -306,6 +352,14 @@ namespace lacerta
     const bool         redistribute_mass    = prm.get_bool("Mass redistribution");
     const unsigned int redistribution_reach = prm.get_integer("Redistribution reach");
     prm.leave_subsection();
+    prm.enter_subsection("Checkpoint");
+    checkpoint.file       = output_directory + "/checkpoint.lcp";
+    checkpoint.steps      = prm.get_integer("Steps between checkpoints");
+    checkpoint.seconds    = prm.get_double("Seconds between checkpoints");
+    checkpoint.resume     = prm.get_bool("Resume");
+    checkpoint.stop_after = prm.get_integer("Stop after steps");
+    prm.leave_subsection();
+    checkpoint.parameters = checkpoint_parameters(prm);
 
     create_output_directory(output_directory);
     std::ostringstream copy;
@@ -333,6 +387,46 @@ namespace lacerta
     }
     scene->system_changed.connect([this](const scene::SystemChange &change)
                                   { on_system_changed(change); });
+    if (checkpoint.steps > 0 || checkpoint.seconds > 0 || checkpoint.stop_after > 0)
+    {
+      // A postprocessor that cannot be resumed says so now, not at the first
+      // checkpoint.
+      std::string scratch;
+      Archive     archive(scratch);
+      for (auto &p : postprocessors)
+        p->serialize(archive);
+    }
+  }
+
+
+  std::string
+  Simulator::checkpoint_parameters(const dealii::ParameterHandler &prm) const
+  {
+    std::ostringstream printed;
+    prm.print_parameters(printed, dealii::ParameterHandler::ShortPRM);
+    std::istringstream       in(printed.str());
+    std::string              line, kept;
+    std::vector<std::string> path;
+    while (std::getline(in, line))
+    {
+      const std::size_t first = line.find_first_not_of(' ');
+      if (first == std::string::npos)
+        continue;
+      const std::string text          = line.substr(first);
+      const auto        in_checkpoint = [&]
+      { return !path.empty() && path.front() == "Checkpoint"; };
+      bool skipped = in_checkpoint();
+      if (text.rfind("subsection ", 0) == 0)
+        path.push_back(text.substr(11));
+      else if (text == "end" && !path.empty())
+        path.pop_back();
+      else if (path.empty())
+        skipped = text.rfind("set End time ", 0) == 0
+                  || text.rfind("set Output directory ", 0) == 0;
+      if (!skipped && !in_checkpoint())
+        kept += text + "\n";
+    }
+    return kept + "threads = " + std::to_string(n_threads) + "\n";
   }
 
 
@@ -430,7 +524,7 @@ namespace lacerta
   Simulator::run()
   {
     start_run();
-    for (step = 1; step <= n_steps; ++step)
+    for (step = step + 1; step <= n_steps; ++step)
     {
       const double dt         = std::min(time_step, end_time - time);
       const auto   step_start = Clock::now();
@@ -448,7 +542,7 @@ namespace lacerta
       state.step_seconds = seconds_since(step_start);
       postprocess();
       report_progress();
-      if (signals.stop && signals.stop())
+      if (checkpoint_if_due() || (signals.stop && signals.stop()))
         break;
     }
     finish_run();
@@ -483,7 +577,11 @@ namespace lacerta
     step           = 0;
     time           = 0;
     steps_done     = 0;
-    postprocess();
+    if (checkpoint.resume)
+      resume_from_checkpoint();
+    else
+      postprocess();
+    checkpoint.last      = Clock::now();
     const double epsilon = 1e-9 * time_step;
     n_steps = static_cast<unsigned int>(std::ceil((end_time - epsilon) / time_step));
     show_progress = !test_mode && isatty(STDERR_FILENO);
@@ -744,5 +842,102 @@ namespace lacerta
                 << " springs/s (whole loop)\n";
       timer->print_summary();
     }
+  }
+
+
+  bool
+  Simulator::checkpoint_if_due()
+  {
+    const bool stop = checkpoint.stop_after > 0 && step >= checkpoint.stop_after;
+    if (stop || (checkpoint.steps > 0 && step % checkpoint.steps == 0)
+        || (checkpoint.seconds > 0
+            && std::chrono::duration<double>(Clock::now() - checkpoint.last).count()
+                 >= checkpoint.seconds))
+      write_checkpoint();
+    if (stop)
+      std::cout << "Stopped after step " << step << " at t = " << time
+                << " s ('Checkpoint/Stop after steps'); 'Checkpoint/Resume = true' "
+                   "continues the run.\n";
+    return stop;
+  }
+
+
+  void
+  Simulator::write_checkpoint()
+  {
+    dealii::TimerOutput::Scope scope(*timer, "checkpoint");
+    std::string                payload;
+    Archive                    archive(payload);
+    archive.section("parameters");
+    archive &checkpoint.parameters;
+    serialize(archive);
+    write_checkpoint_file(checkpoint.file, payload);
+    checkpoint.last = Clock::now();
+  }
+
+
+  void
+  Simulator::resume_from_checkpoint()
+  {
+    std::string payload, file = checkpoint.file;
+    try
+    {
+      payload = read_checkpoint_file(file);
+    }
+    catch (const Error &last)
+    {
+      // A checkpoint damaged on the disk: the one before it was kept for this.
+      const std::string previous = checkpoint.file + ".previous";
+      if (!std::filesystem::exists(previous))
+        throw;
+      std::cout << last.what() << " Resuming from the previous checkpoint.\n";
+      file    = previous;
+      payload = read_checkpoint_file(file);
+    }
+    Archive archive(payload, file);
+    archive.section("parameters");
+    std::string written;
+    archive    &written;
+    if (written != checkpoint.parameters)
+    {
+      // Name the first entry that differs.
+      std::istringstream a(written), b(checkpoint.parameters);
+      std::string        line_a, line_b;
+      while (std::getline(a, line_a) && std::getline(b, line_b) && line_a == line_b)
+        ;
+      throw_error("Checkpoint: '",
+                  file,
+                  "' was written with other parameters: '",
+                  line_a,
+                  "' where this run has '",
+                  line_b,
+                  "'. Only 'End time', 'Output directory' and 'subsection Checkpoint' "
+                  "may change when a run is resumed.");
+    }
+    serialize(archive);
+    archive.finish();
+    std::cout << "Resumed from " << file << " after step " << step << ", t = " << time
+              << " s\n";
+  }
+
+
+  void
+  Simulator::serialize(Archive &archive)
+  {
+    archive.section("simulator");
+    archive(step, time, n_integrator_steps, redistribution);
+    archive(state.step, state.time, state.time_step, state.substeps);
+    archive(state.kinetic_energy, state.elastic_energy, state.body_force_energy);
+    archive(state.input_work);
+    archive &*scene;
+    // The integrator's scratch space follows the loaded system, as after any change;
+    // what it carries between steps is then read into it.
+    if (archive.loading())
+      integrator->initialize(*scene->system);
+    archive(*integrator, monitor, stability_bound, mass_balancer);
+    archive.section("postprocessors");
+    for (auto &p : postprocessors)
+      p->serialize(archive);
+    steps_done = step;
   }
 } // namespace lacerta

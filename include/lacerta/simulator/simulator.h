@@ -37,6 +37,8 @@ namespace lacerta::physics
 
 namespace lacerta
 {
+  class Archive;
+
   /**
    * Hooks into the main loop for a program that drives a scene interactively
    * (lacerta-view), after ASPECT's SimulatorSignals. Each is optional; the simulation
@@ -154,6 +156,34 @@ namespace lacerta
     finish_run();
 
     /**
+     * After a step: writes a checkpoint if one is due (`subsection Checkpoint`);
+     * returns whether the run stops here (`Stop after steps`).
+     */
+    bool
+    checkpoint_if_due();
+
+    /// Writes the checkpoint of the state after the current step.
+    void
+    write_checkpoint();
+
+    /**
+     * With `Resume`: reads the last checkpoint (the previous one if the last is
+     * damaged) into the state start_run() built, instead of the postprocessors' step 0.
+     */
+    void
+    resume_from_checkpoint();
+
+    /// Writes or reads everything the run carries from one step to the next: the
+    /// scene, the integrator, the monitors, the redistribution, the postprocessors.
+    void
+    serialize(Archive &archive);
+
+    /// The parameters a checkpoint must have been written with to be resumed: all but
+    /// `End time`, `Output directory` and `subsection Checkpoint`, and the threads.
+    std::string
+    checkpoint_parameters(const dealii::ParameterHandler &prm) const;
+
+    /**
      * The simulator's subscriber to Scene::system_changed: the mass redistribution,
      * the invariants (after a local change), the integrator's scratch space, the
      * blow-up monitor's ledger and the stability bound follow the changed system, and
@@ -227,7 +257,18 @@ namespace lacerta
     double                                change_seconds = 0;
     std::unique_ptr<dealii::TimerOutput>  timer;
     std::chrono::steady_clock::time_point run_start;
-    double                                last_progress = 0;
-    bool                                  show_progress = false;
+    /// `subsection Checkpoint`: where, how often (steps, wall seconds; 0: never),
+    /// whether to resume, and after how many steps to stop (0: at the end).
+    struct
+    {
+      std::string                           file;
+      unsigned int                          steps = 0, stop_after = 0;
+      double                                seconds = 0;
+      bool                                  resume  = false;
+      std::string                           parameters;
+      std::chrono::steady_clock::time_point last;
+    } checkpoint;
+    double last_progress = 0;
+    bool   show_progress = false;
   };
 } // namespace lacerta
