@@ -1,7 +1,9 @@
 // lacerta-bench soak: many random scalpel strokes, partial and complete, some crossing
 // earlier cuts, on the pulled slab of square_tear.prm with tears enabled and the
 // invariants checked after every step; with the multiresolution model off and on.
-// Every episode runs in a child process, so a crash is counted, not suffered.
+// Every episode runs in a child process, so a crash is counted, not suffered. With
+// --resume-check every completed episode is also stopped at a random step and resumed
+// from its checkpoint, and must end bit for bit as it did.
 
 #include <lacerta/base/exceptions.h>
 #include <lacerta/base/output_file.h>
@@ -17,6 +19,8 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <random>
 #include <sstream>
 #include <string>
@@ -41,7 +45,10 @@ namespace lacerta::bench
       bool         with_lod            = true;
       std::string  directory           = "soak";
       /// Which outcomes make the exit code 1, indexed by Outcome (all but `completed`).
-      std::vector<bool> fails = {false, true, true, true, true};
+      std::vector<bool> fails = {false, true, true, true, true, true};
+      /// Whether every completed episode is also stopped at a random step and resumed
+      /// from its checkpoint, and must end bit for bit as it did uninterrupted.
+      bool resume_check = false;
       /// Extra entries `Subsection/.../Entry=value` added to every episode.
       std::vector<std::string> settings;
     };
@@ -182,6 +189,7 @@ namespace lacerta::bench
                        const unsigned int              n_strokes,
                        const bool                      lod,
                        const std::vector<std::string> &settings,
+                       const bool                      resume_check,
                        unsigned int                   &complete)
     {
       EpisodeScript script(random);
@@ -210,7 +218,8 @@ namespace lacerta::bench
           << "end\n"
           << "subsection Tool\n  set Type = scalpel\n  subsection Scalpel\n"
           << "    set Keyframes = " << script.keyframes() << "\n  end\nend\n"
-          << "subsection Postprocess\n  set List of postprocessors =\nend\n";
+          << "subsection Postprocess\n  set List of postprocessors ="
+          << (resume_check ? " statistics, vtu" : "") << "\nend\n";
       if (lod)
         prm << "subsection Multiresolution\n"
             << "  set Enabled = true\n"
@@ -234,7 +243,9 @@ namespace lacerta::bench
       invariant_violation,
       blow_up,
       other_error,
-      crash
+      crash,
+      /// Resumed from a checkpoint, the episode did not end as it did uninterrupted.
+      resume_mismatch
     };
 
     /**
@@ -303,11 +314,75 @@ namespace lacerta::bench
     }
 
     /// The names of the outcomes on the command line, indexed by Outcome.
-    const std::vector<std::string> outcome_names = {"completed",
-                                                    "invariants",
-                                                    "blow-ups",
-                                                    "errors",
-                                                    "crashes"};
+    const std::vector<std::string> outcome_names =
+      {"completed", "invariants", "blow-ups", "errors", "crashes", "resumes"};
+
+
+    /// The contents of @p file ("" if it cannot be read).
+    std::string
+    contents_of(const std::filesystem::path &file)
+    {
+      std::ifstream in(file, std::ios::binary);
+      return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    }
+
+    /**
+     * The episode @p file ran to its end into `output/`: runs it again into
+     * `output-resumed/`, with a checkpoint every few steps, stopped at a random step
+     * and resumed, and compares the statistics and every VTU file of both, byte for
+     * byte. Returns `completed` if they are identical.
+     */
+    Outcome
+    check_resume(const std::string &file, std::mt19937_64 &random, std::string &message)
+    {
+      namespace fs       = std::filesystem;
+      const auto n_lines = [](const std::string &text)
+      { return static_cast<unsigned int>(std::count(text.begin(), text.end(), '\n')); };
+      const std::string statistics = contents_of("output/statistics.csv");
+      // The header, step 0, then one row per step.
+      const unsigned int n_steps =
+        n_lines(statistics) - std::min(2u, n_lines(statistics));
+      if (n_steps < 2)
+        return Outcome::completed;
+      const auto pick = [&](const unsigned int lo, const unsigned int hi)
+      { return std::uniform_int_distribution<unsigned int>(lo, hi)(random); };
+      const unsigned int stop  = pick(1, n_steps - 1);
+      const unsigned int every = pick(1, stop);
+      fs::remove_all("output-resumed");
+      for (const bool resume : {false, true})
+      {
+        const std::string  run = file + (resume ? ".resume.prm" : ".stop.prm");
+        std::ostringstream prm;
+        prm << "include " << file << "\nset Output directory = output-resumed\n"
+            << "subsection Checkpoint\n  set Steps between checkpoints = " << every
+            << "\n  set " << (resume ? "Resume = true" : "Stop after steps = ")
+            << (resume ? "" : std::to_string(stop)) << "\nend\n";
+        write_file_atomically(run, prm.str());
+        const Outcome outcome = run_episode(run, run + ".log", message);
+        if (outcome != Outcome::completed)
+        {
+          message = (resume ? "resumed after step " : "stopped after step ")
+                    + std::to_string(stop) + ": " + message;
+          return Outcome::resume_mismatch;
+        }
+        fs::remove(run);
+        fs::remove(run + ".log");
+      }
+      std::vector<std::string> files = {"statistics.csv", "solution.pvd"};
+      for (const auto &entry : fs::directory_iterator("output"))
+        if (entry.path().extension() == ".vtu")
+          files.push_back(entry.path().filename().string());
+      for (const std::string &name : files)
+        if (contents_of(fs::path("output") / name)
+            != contents_of(fs::path("output-resumed") / name))
+        {
+          message = "stopped after step " + std::to_string(stop) + " (checkpoints every "
+                    + std::to_string(every) + " steps) and resumed: " + name
+                    + " differs from the uninterrupted run's";
+          return Outcome::resume_mismatch;
+        }
+      return Outcome::completed;
+    }
 
 
     /// The soak in one mode; returns the number of episodes whose outcome fails it.
@@ -319,11 +394,14 @@ namespace lacerta::bench
         std::filesystem::absolute(options.directory) / mode;
       std::filesystem::create_directories(directory);
       std::mt19937_64 random(options.seed + (lod ? 1000003 : 0));
+      // The stops of --resume-check draw from their own generator: the episodes are
+      // those of the same seed without it.
+      std::mt19937_64 resume_random(options.seed + (lod ? 2000003 : 1000));
 
       const unsigned int n_episodes =
         (options.strokes + options.strokes_per_episode - 1) / options.strokes_per_episode;
       unsigned int strokes = 0, complete = 0, failed = 0;
-      unsigned int counts[5] = {0, 0, 0, 0, 0};
+      unsigned int counts[6] = {0, 0, 0, 0, 0, 0};
       const auto   start     = Clock::now();
       for (unsigned int e = 0; e < n_episodes; ++e)
       {
@@ -332,11 +410,17 @@ namespace lacerta::bench
         const std::string file =
           (directory / ("episode-" + std::to_string(e) + ".prm")).string();
         write_file_atomically(
-          file, episode_parameters(random, n, lod, options.settings, complete));
+          file,
+          episode_parameters(
+            random, n, lod, options.settings, options.resume_check, complete));
         strokes += n;
-        std::string   message;
-        const Outcome outcome =
+        std::string message;
+        if (options.resume_check)
+          std::filesystem::remove_all("output"); // compared file by file afterwards
+        Outcome outcome =
           run_episode(file, (directory / "last-episode.log").string(), message);
+        if (outcome == Outcome::completed && options.resume_check)
+          outcome = check_resume(file, resume_random, message);
         ++counts[static_cast<int>(outcome)];
         failed += options.fails[static_cast<int>(outcome)];
         if (outcome == Outcome::completed)
@@ -361,8 +445,9 @@ namespace lacerta::bench
       const char *failures[] = {"invariant violations",
                                 "blow-ups",
                                 "other errors",
-                                "crashes"};
-      for (unsigned int k = 0; k < 4; ++k)
+                                "crashes",
+                                "resume mismatches"};
+      for (unsigned int k = 0; k < (options.resume_check ? 5 : 4); ++k)
         print_figure(mode + " " + failures[k], counts[k + 1], "episodes");
       print_figure(mode + " wall time", seconds, "s");
       return failed;
@@ -392,13 +477,15 @@ namespace lacerta::bench
             const auto found =
               std::find(outcome_names.begin() + 1, outcome_names.end(), name);
             if (found == outcome_names.end())
-              throw_error("soak: --fail-on takes invariants, blow-ups, errors and "
-                          "crashes, not '",
+              throw_error("soak: --fail-on takes invariants, blow-ups, errors, "
+                          "crashes and resumes, not '",
                           name,
                           "'.");
             options.fails[found - outcome_names.begin()] = true;
           }
         }
+        else if (key == "--resume-check")
+          options.resume_check = true;
         else if (key == "--set" && value)
           options.settings.push_back(arguments[++i]);
         else if (key == "--directory" && value)
@@ -418,7 +505,8 @@ namespace lacerta::bench
                        "[--strokes-per-episode K (5)] [--multiresolution off|on|both] "
                        "[--seed S (1)] [--directory D (soak)] "
                        "[--set 'Subsection/Entry=value' ...] "
-                       "[--fail-on invariants,blow-ups,errors,crashes (all)]\n");
+                       "[--resume-check] "
+                       "[--fail-on invariants,blow-ups,errors,crashes,resumes (all)]\n");
           return 2;
         }
       }
