@@ -2,7 +2,8 @@
 #
 # Runs the regression scene SCENE (a tests/*.prm.in) three ways in WORK:
 #   full/  uninterrupted;
-#   part/  with a checkpoint every EVERY steps, stopped after STOP steps
+#   part/  with a checkpoint every EVERY steps (or SECONDS of wall time), stopped after
+#          STOP steps
 #          ('Checkpoint/Stop after steps'), or, with KILL_AFTER set, killed (SIGKILL)
 #          that many seconds after it started, whatever it is doing then (a step, a
 #          checkpoint being written);
@@ -13,7 +14,8 @@
 # entry changed must also be refused with a message naming it.
 #
 # Variables: LACERTA, SCENE, SOURCE_DIR (for @CMAKE_SOURCE_DIR@ in SCENE), WORK, STOP,
-# EVERY, and optionally KILL_AFTER and CHANGED_ENTRY.
+# EVERY (or SECONDS: checkpoints by wall time instead of steps), and optionally
+# KILL_AFTER and CHANGED_ENTRY.
 
 set(CMAKE_SOURCE_DIR ${SOURCE_DIR})
 file(REMOVE_RECURSE ${WORK})
@@ -41,7 +43,11 @@ endfunction()
 write_run(full full "")
 run(full TRUE)
 
-set(_every "  set Steps between checkpoints = ${EVERY}\n")
+if(DEFINED SECONDS)
+  set(_every "  set Seconds between checkpoints = ${SECONDS}\n")
+else()
+  set(_every "  set Steps between checkpoints = ${EVERY}\n")
+endif()
 if(DEFINED KILL_AFTER)
   # Killed wherever it is: the last complete checkpoint (or the one before it, if the
   # kill came while the last was being written) must resume. The kill must come after
@@ -69,6 +75,9 @@ else()
 endif()
 if(NOT EXISTS ${WORK}/part/checkpoint.lcp)
   message(FATAL_ERROR "no checkpoint was written")
+endif()
+if(DEFINED SECONDS AND NOT EXISTS ${WORK}/part/checkpoint.lcp.previous)
+  message(FATAL_ERROR "no checkpoint was written by wall time before the stop's")
 endif()
 
 if(DEFINED CHANGED_ENTRY)
