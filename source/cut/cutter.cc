@@ -63,11 +63,14 @@ namespace lacerta::cut
   Cutter::declare_parameters(dealii::ParameterHandler &prm)
   {
     prm.enter_subsection("Cut");
-    prm.declare_entry("Snap fraction",
-                      "0.05",
-                      dealii::Patterns::Double(0.001, 0.45),
-                      "A cut point closer than this fraction of its edge to an end "
-                      "snaps onto that end (doc/split-table.md): no sliver is created.");
+    prm.declare_entry(
+      "Snap fraction",
+      "0.05",
+      dealii::Patterns::Double(0.001, 0.45),
+      "A cut point closer to an end of its edge than this fraction of the "
+      "size of the cells around the edge (their longest edge at rest) "
+      "snaps onto that end (doc/cutting.md, step 5): no sliver is "
+      "created, and a layer an earlier cut left thin is not cut thinner.");
     prm.declare_entry("Max advance",
                       "0.5",
                       dealii::Patterns::Double(0.01, 10.0),
@@ -486,13 +489,20 @@ namespace lacerta::cut
           }
           continue;
         }
-        // Snapping, once: an end closer to the swept surface than ε times the edge's
-        // length is put on the cut (the edge is then not cut), unless a crossing of
-        // another of its edges was decided before. Then no cut point lies within ε of
-        // an end, and an edge nearly in the surface (a blade along a face) does not
-        // shave a sliver off it.
-        const bool snap_a = distance[0] < eps && may_snap(a);
-        const bool snap_b = distance[1] < eps && may_snap(b);
+        // Snapping, once: an end closer to the swept surface than ε times the size of
+        // the cells around the edge (their longest edge) is put on the cut (the edge
+        // is then not cut), unless a crossing of another of its edges was decided
+        // before. Then no cut point lies within ε of a cell's size from an end: an
+        // edge nearly in the surface (a blade along a face) does not shave a sliver
+        // off it, and a short edge in a fat cell (left by an earlier cut) is not cut
+        // again next to its end, where the spring's stiffness E V / |e|² would grow
+        // like the inverse square of the distance while the cell's volume does not.
+        const double relative =
+          eps
+          * std::max(1.0,
+                     cell_size_around(a, b) / norm(sub(mesh.vertex(b), mesh.vertex(a))));
+        const bool snap_a = distance[0] < relative && may_snap(a);
+        const bool snap_b = distance[1] < relative && may_snap(b);
         if (snap_a)
           put_on_surface(a);
         if (snap_b)
@@ -564,6 +574,28 @@ namespace lacerta::cut
       side_records.resize(std::size_t(v) + 256);
     if (kept_side(v, normal) == 0)
       side_records[v] = {side, stroke, normal};
+  }
+
+
+  double
+  Cutter::cell_size_around(const unsigned int a, const unsigned int b) const
+  {
+    // A cell's size: its longest edge at rest. A layer that earlier cuts made thin
+    // keeps the size of the cell it came from, so that the next cut beside it does not
+    // thin it again (each cut would otherwise take a fraction of what the last left).
+    double size = 0;
+    mesh.visit_tets_with_edge(a,
+                              b,
+                              [&](const unsigned int t, unsigned int)
+                              {
+                                const mesh::Tet &tet = mesh.tet(t);
+                                for (const auto &e : tet_edge_vertices)
+                                  size = std::max(size,
+                                                  norm(sub(mesh.vertex(tet[e[1]]),
+                                                           mesh.vertex(tet[e[0]]))));
+                                return false;
+                              });
+    return size;
   }
 
 

@@ -754,15 +754,42 @@ namespace
 } // namespace
 
 
+TEST(CutCutter, ASecondCutBesideAnEarlierOneDoesNotCutItsShortEdgesNearTheirEnds)
+{
+  // The first cut, at y = 0.45, leaves edges 0.05 long between it and the vertex layer
+  // y = 0.5 in cells 0.25 across. The second, at y = 0.4925, passes 15 % of those short
+  // edges from the layer: a fraction of the edge's length would cut them there and
+  // leave springs 0.0075 long; the snapping distance is a fraction of the cells'
+  // size, so the layer's vertices go onto the cut instead.
+  for (const unsigned int seed : {1u, 2u, 3u})
+  {
+    std::mt19937 rng(seed);
+    CutFixture   f(4, rng, vertical(-0.2, 0.45));
+    f.stroke({vertical(-0.2, 0.45), vertical(1.2, 0.45)}, 8);
+    f.cutter->move_blade({{{1.2, 0.4925, 2.0}}, {{1.2, 0.4925, 1.6}}});
+    f.cutter->move_blade({{{1.2, 0.4925, 2.0}}, {{-0.2, 0.4925, 2.0}}});
+    f.cutter->move_blade(vertical(-0.2, 0.4925));
+    f.stroke({vertical(-0.2, 0.4925), vertical(1.2, 0.4925)}, 8);
+    ASSERT_FALSE(::testing::Test::HasFatalFailure());
+    EXPECT_EQ(f.component_volumes().size(), 3u) << "seed " << seed;
+    double shortest = 1;
+    for (const auto &e : f.mesh.get_edges())
+      shortest =
+        std::min(shortest, cut::norm(cut::sub(f.mesh.vertex(e[1]), f.mesh.vertex(e[0]))));
+    EXPECT_GT(shortest, cut::default_snap_fraction * 0.25) << "seed " << seed;
+  }
+}
+
+
 TEST(CutCutter, ACutNearAVertexLayerKeepsTheCriticalStepWithMassRedistribution)
 {
-  // The plane y = 0.4825 passes 7 % of an edge (0.25) from the vertex layer y = 0.5,
+  // The plane y = 0.475 passes 10 % of an edge (0.25) from the vertex layer y = 0.5,
   // above the snap fraction: the cells between are thin and their particles light.
   std::mt19937          rng(3);
-  CutFixture            f(4, rng, vertical(-0.2, 0.4825));
+  CutFixture            f(4, rng, vertical(-0.2, 0.475));
   physics::MassBalancer balancer(*f.system, 3);
   const double          before = physics::bound_highest_frequency(*f.system).omega;
-  f.stroke({vertical(-0.2, 0.4825), vertical(1.2, 0.4825)}, 8);
+  f.stroke({vertical(-0.2, 0.475), vertical(1.2, 0.475)}, 8);
   ASSERT_FALSE(::testing::Test::HasFatalFailure());
   ASSERT_EQ(f.component_volumes().size(), 2u);
   const double cut = physics::bound_highest_frequency(*f.system).omega;
@@ -789,7 +816,7 @@ TEST(CutCutter, LocalRebalancingAfterEveryBladeMotionKeepsTheCriticalStep)
   // As above, with the simulator's local redistribution after every blade motion that
   // changed the mesh, from the particles that motion changed only.
   std::mt19937          rng(3);
-  CutFixture            f(4, rng, vertical(-0.2, 0.4825));
+  CutFixture            f(4, rng, vertical(-0.2, 0.475));
   physics::MassBalancer balancer(*f.system, 3);
   f.system->clear_changes();
   // A moving body, so that the momentum the mass carries matters.
@@ -825,7 +852,7 @@ TEST(CutCutter, LocalRebalancingAfterEveryBladeMotionKeepsTheCriticalStep)
       EXPECT_NEAR(after[c], before[c], 1e-12 * before[3]);
     f.system->clear_changes();
   };
-  f.stroke({vertical(-0.2, 0.4825), vertical(1.2, 0.4825)}, 8);
+  f.stroke({vertical(-0.2, 0.475), vertical(1.2, 0.475)}, 8);
   ASSERT_FALSE(::testing::Test::HasFatalFailure());
   ASSERT_GT(motions, 0u);
   EXPECT_GT(raised, 0u);

@@ -273,6 +273,10 @@ namespace lacerta::cut
     /// @p normal, unless a side was decided for that part already.
     void
     keep_side(unsigned int v, std::int8_t side, const Point &normal);
+    /// The size of the cells around the edge from @p a to @p b (their longest edge at
+    /// rest): the snapping distance is a fraction of it.
+    double
+    cell_size_around(unsigned int a, unsigned int b) const;
     /// Whether vertex @p v may be put on the cut (snapping).
     bool
     may_snap(unsigned int v) const;
