@@ -264,7 +264,7 @@ namespace lacerta::mesh
         const Tet &q = tets[t];
         // Without short-circuits: which cells of the star hold w follows no pattern
         // a branch predictor learns.
-        if (!((q[0] == w) | (q[1] == w) | (q[2] == w) | (q[3] == w)))
+        if (!(int(q[0] == w) | int(q[1] == w) | int(q[2] == w) | int(q[3] == w)))
           continue;
         unsigned int j = 0;
         while (q[j] != w)
