@@ -113,7 +113,7 @@ namespace lacerta::bench
       for (unsigned int k = 1; k <= n_steps; ++k)
       {
         const auto s = cutter.move_blade(blade(0.06 + (end - 0.06) * k / n_steps));
-        if (s.cut_tets == 0)
+        if (!s.changed)
           continue;
         const auto r0 = Clock::now();
         balancer.rebalance(system, system.changed_particles());
