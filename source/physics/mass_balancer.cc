@@ -45,7 +45,8 @@ namespace lacerta::physics
      * is asked. All or nothing: when the particles within reach cannot spare @p need
      * together, nothing moves (mass that leaves the particle above the target does not
      * lower the largest bound, and only changes the dynamics). Calls
-     * @p on_gift(donor, mass) for every gift; returns the mass moved.
+     * @p on_gift(donor, mass) for every gift, before the mass moves; returns the mass
+     * moved.
      */
     template <typename ForEachNeighbour, typename RowSum, typename OnGift>
     double
@@ -106,9 +107,9 @@ namespace lacerta::physics
         for (unsigned int d = first[r]; d < first[r + 1]; ++d)
         {
           const double given = fraction * spare[d];
-          move_mass(system, donors[d], i, given);
           if (given > 0)
             on_gift(donors[d], given);
+          move_mass(system, donors[d], i, given);
         }
         left -= fraction * in_ring;
       }
@@ -303,13 +304,52 @@ namespace lacerta::physics
       touched_stamp = 1;
     }
     grow_region(to_check);
-    // A taker that gave on some of what it took would owe it: its own gifts are
-    // taken back with it (cascade). The gifts are taken back at once, each with the
-    // velocity its taker has now: taken back one after the other, a particle could
-    // hold a negative mass in between, and the velocity of what it then receives
-    // would be divided by it.
+    // The rows at rest, computed when first asked for: those of the particles to
+    // check at once, a donor's when its taker asks its ring. A particle the change did
+    // not touch and that gives nothing keeps its mass and its springs, hence its row
+    // and whether it is above the limit: the cost follows the particles that need
+    // mass, not every particle within reach of the change.
+    if (++row_stamp == 0)
+    {
+      std::fill(row_known.begin(), row_known.end(), 0);
+      row_stamp = 1;
+    }
+    row_known.resize(n, 0);
+    row_sum.resize(n, 0.0);
+    const auto compute_rows = [&](const std::vector<unsigned int> &rows)
+    {
+      row_values.resize(rows.size());
+      gershgorin_row_sums(
+        system, system.rest_position().data(), rows, scratch, row_values.data());
+      for (std::size_t k = 0; k < rows.size(); ++k)
+      {
+        row_sum[rows[k]]   = row_values[k];
+        row_known[rows[k]] = row_stamp;
+      }
+    };
+    compute_rows(to_check);
+    const auto row = [&](const unsigned int j)
+    {
+      if (row_known[j] != row_stamp)
+      {
+        single_row.assign(1, j);
+        compute_rows(single_row);
+      }
+      return row_sum[j];
+    };
+    const double limit = donor_headroom * target_lambda;
+    // A taker left unable to afford what it gave on (its mass after the take-backs
+    // below what keeps its bound at the donors' limit, or even negative) owes it: its
+    // own gifts are taken back with it (cascade). One that can afford them keeps
+    // them: otherwise the light particles along a crack, each raised in part by the
+    // one before, would form chains of gifts as long as the crack, and every cut step
+    // would take back and give again along all of it. The gifts are taken back at
+    // once, each with the velocity its taker has now: taken back one after the
+    // other, a particle could hold a negative mass in between, and the velocity of
+    // what it then receives would be divided by it.
     cascade.clear();
     taken_back.clear();
+    pending.resize(n, 0.0);
     const auto take_back = [&](const unsigned int g)
     {
       Gift &gift = gifts[g];
@@ -319,7 +359,9 @@ namespace lacerta::physics
       to_check.push_back(gift.taker);
       cascade.push_back(gift.taker);
       returned[g] = gift.mass;
-      gift.mass   = 0;
+      pending[gift.taker] -= gift.mass;
+      pending[gift.donor] += gift.mass;
+      gift.mass = 0;
       --n_live_gifts;
     };
     returned.resize(gifts.size(), 0.0);
@@ -331,10 +373,14 @@ namespace lacerta::physics
     {
       const unsigned int t = cascade.back();
       cascade.pop_back();
+      if (system.mass[t] + pending[t] >= row(t) / limit)
+        continue;
       for (const unsigned int g : gifts_of[t])
         if (gifts[g].mass > 0 && gifts[g].donor == t)
           take_back(g);
     }
+    for (const unsigned int p : touched)
+      pending[p] = 0;
     // Mass and momentum, from the state before: each gift goes back to its donor with
     // its taker's velocity. What leaves a particle has its velocity, so only what
     // arrives changes it: v += Σ m (v_from - v) / m_new, with no difference of large
@@ -361,17 +407,8 @@ namespace lacerta::physics
       in_region[p] = 0;
     std::sort(to_check.begin(), to_check.end());
     to_check.erase(std::unique(to_check.begin(), to_check.end()), to_check.end());
-    // The region to balance: the particles to check and their donors.
-    grow_region(to_check);
     const std::size_t n_changed = to_check.size();
-    row_sum.resize(region.size());
-    gershgorin_row_sums(
-      system, system.rest_position().data(), region, scratch, row_sum.data());
-    row_of.resize(n, 0);
-    for (std::size_t k = 0; k < region.size(); ++k)
-      row_of[region[k]] = static_cast<unsigned int>(k);
-    const auto row    = [&](const unsigned int j) { return row_sum[row_of[j]]; };
-    const auto lambda = [&](const unsigned int i)
+    const auto        lambda    = [&](const unsigned int i)
     {
       const double m = system.mass[i];
       return m > 0 ? row(i) / m : std::numeric_limits<double>::infinity();
@@ -381,35 +418,38 @@ namespace lacerta::physics
     // the masses as they are: the cutter updates the lumped part of a mass and keeps
     // the part moved before (mass_shift).
     const double tolerance = 1 + 1e-9;
-    const double limit     = donor_headroom * target_lambda;
-    for (const unsigned int p : region)
+    for (const unsigned int p : to_check)
       touch(p);
     seen.resize(n, 0);
     for (std::size_t k = 0; k < n_changed; ++k)
     {
-      const unsigned int i = region[k];
+      const unsigned int i = to_check[k];
       if (!(system.free[i] > 0) || !(lambda(i) > tolerance * target_lambda))
         continue;
-      const double need = row(i) / (target_lambda / (1 + 1e-6)) - system.mass[i];
-      const double moved =
-        borrow(system,
-               for_each_neighbour,
-               row,
-               i,
-               need,
-               limit,
-               reach,
-               seen,
-               spare,
-               donors,
-               ring_first,
-               ring,
-               [&](const unsigned int d, const double m) { record_gift(d, i, m); });
+      const double need  = row(i) / (target_lambda / (1 + 1e-6)) - system.mass[i];
+      const double moved = borrow(system,
+                                  for_each_neighbour,
+                                  row,
+                                  i,
+                                  need,
+                                  limit,
+                                  reach,
+                                  seen,
+                                  spare,
+                                  donors,
+                                  ring_first,
+                                  ring,
+                                  [&](const unsigned int d, const double m)
+                                  {
+                                    touch(d);
+                                    record_gift(d, i, m);
+                                  });
       statistics.raised += moved > 0;
     }
-    for (const unsigned int p : region)
+    // Whether each particle is above the limit changes only where a mass or a row
+    // changed: at the particles checked and those that gave or took back.
+    for (const unsigned int p : touched)
     {
-      in_region[p]     = 0;
       const bool above = system.free[p] > 0 && lambda(p) > tolerance * limit;
       n_unresolved += static_cast<unsigned int>(above) - unresolved[p];
       unresolved[p] = above;

@@ -131,18 +131,25 @@ namespace lacerta::physics
     /// their masses, the particles' momenta (rebalance()).
     std::vector<unsigned int> cascade, taken_back;
     std::vector<double>       returned, momentum_of;
-    unsigned int              n_live_gifts = 0;
+    /// The mass each particle gains (or loses) by the gifts being taken back.
+    std::vector<double> pending;
+    unsigned int        n_live_gifts = 0;
     /// Rebuilds the ledger without the gifts taken back once they are most of it.
     void
     compact_gifts();
 
     /// Scratch of rebalance(), kept so that a local call allocates nothing once grown.
-    std::vector<unsigned int> region, row_of, mark, to_check, touched, touched_mark;
+    std::vector<unsigned int> region, mark, to_check, touched, touched_mark;
     std::vector<double>       before_of;
     unsigned int              touched_stamp = 0;
     std::vector<std::uint8_t> in_region;
     std::vector<char>         seen;
     std::vector<double>       row_sum, spare;
+    /// Which rows at rest rebalance() computed in this call (`row_known` equal to
+    /// `row_stamp`), and the scratch of their computation.
+    std::vector<unsigned int> row_known, single_row;
+    std::vector<double>       row_values;
+    unsigned int              row_stamp = 0;
     /// The donors of one borrowing, ring by ring: where each ring starts, the ring.
     std::vector<unsigned int> donors, ring_first, ring;
     unsigned int              stamp = 0;
