@@ -168,6 +168,51 @@ namespace lacerta::cut
       it = forget_crossing(it);
     // The vertices' sides belong to this stroke.
     ++stroke;
+    part.started = false;
+  }
+
+
+  void
+  Cutter::follow_part(const std::array<std::array<Point, 3>, 2> &swept_triangles,
+                      const Point                               &normal)
+  {
+    // The middle of the blade before and after the sweep (swept_triangles[0] is
+    // {from.tail, from.head, to.tail}, swept_triangles[1] {to.tail, from.head, to.head}).
+    part.from = scale(0.5, add(swept_triangles[0][0], swept_triangles[0][1]));
+    const Point motion =
+      sub(scale(0.5, add(swept_triangles[1][0], swept_triangles[1][2])), part.from);
+    const double length = norm(motion);
+    part.motion         = length > 0 ? scale(1 / length, motion) : Point{};
+    if (!part.started || dot(part.normal, normal) <= same_part_cosine)
+      part.triangles.clear();
+    part.started = true;
+    part.normal  = normal;
+  }
+
+
+  void
+  Cutter::keep_part_sweep(const std::array<std::array<Point, 3>, 2> &swept_triangles)
+  {
+    if (part.triangles.size() >= 2 * std::size_t(kept_part_sweeps))
+      part.triangles.erase(part.triangles.begin(), part.triangles.begin() + 2);
+    part.triangles.insert(part.triangles.end(),
+                          swept_triangles.begin(),
+                          swept_triangles.end());
+  }
+
+
+  bool
+  Cutter::part_reaches(const unsigned int                         v,
+                       const double                               distance,
+                       const std::array<std::array<Point, 3>, 2> &swept_triangles) const
+  {
+    const Point x = position(v);
+    if (dot(sub(x, part.from), part.motion) >= -distance)
+      return true;
+    const auto near = [&](const std::array<Point, 3> &t)
+    { return mesh::point_triangle_distance(x, t[0], t[1], t[2]) <= distance; };
+    return std::any_of(swept_triangles.begin(), swept_triangles.end(), near)
+           || std::any_of(part.triangles.begin(), part.triangles.end(), near);
   }
 
 
@@ -448,6 +493,7 @@ namespace lacerta::cut
       return; // the blade moved along itself: it sweeps no surface
     normal         = normalized(normal);
     sweep_triangle = swept_triangles[0];
+    follow_part(swept_triangles, normal);
     ++analysis_stamp;
     for (const unsigned int t : candidates)
       for (unsigned int e = 0; e < 6; ++e)
@@ -497,12 +543,21 @@ namespace lacerta::cut
         // off it, and a short edge in a fat cell (left by an earlier cut) is not cut
         // again next to its end, where the spring's stiffness E V / |e|² would grow
         // like the inverse square of the distance while the cell's volume does not.
+        // Only onto a part of the surface that reaches the end: an end behind the
+        // corner where this part started is not on it, however close to its plane
+        // (the blade never swept there in this direction; put on the cut, its faces
+        // and the previous part's cut points enclosed fragments).
         const double relative =
           eps
           * std::max(1.0,
                      cell_size_around(a, b) / norm(sub(mesh.vertex(b), mesh.vertex(a))));
-        const bool snap_a = distance[0] < relative && may_snap(a);
-        const bool snap_b = distance[1] < relative && may_snap(b);
+        const double reach_of_snap = relative * norm(sub(position(b), position(a)));
+        const bool   snap_a        = distance[0] < relative
+                            && part_reaches(a, reach_of_snap, swept_triangles)
+                            && may_snap(a);
+        const bool snap_b = distance[1] < relative
+                            && part_reaches(b, reach_of_snap, swept_triangles)
+                            && may_snap(b);
         if (snap_a)
           put_on_surface(a);
         if (snap_b)
@@ -514,6 +569,7 @@ namespace lacerta::cut
         ++crossings_at[b];
         new_crossings.push_back(key);
       }
+    keep_part_sweep(swept_triangles);
   }
 
 
@@ -1255,5 +1311,6 @@ namespace lacerta::cut
     archive.section("cutter");
     archive(current, typical_edge, tree, active, on_surface, on_surface_list);
     archive(side_records, blade_cell_positions, stroke, crossings, crossings_at, adopted);
+    archive(part.started, part.normal, part.from, part.motion, part.triangles);
   }
 } // namespace lacerta::cut

@@ -873,6 +873,54 @@ TEST(CutCutter, LocalRebalancingAfterEveryBladeMotionKeepsTheCriticalStep)
 }
 
 
+TEST(CutCutter, APartOfTheSurfaceThatStartsAtACornerDoesNotReachBehindIt)
+{
+  // The blade arrives obliquely at a corner (0.25, 0.6) and turns down a plane of
+  // mesh vertices (x = 0.25). The vertices of that plane behind the corner (y =
+  // 0.625, 0.025 beyond it) are not on the surface the blade swept after turning; put
+  // on the cut, they took faces beyond the corner into the crack, and where the cut
+  // points of the first leg closed them in, a fragment (the stroke corpus's bow-tie).
+  // The cut surface stays within the snapping distance (ε times a cell's longest edge,
+  // 0.05 x 0.2165) of the path, whatever rounding noise the positions carry (an edge
+  // lying in the plane is then found crossing it either way).
+  const std::array<std::array<double, 2>, 3> path = {
+    {{{1.2, 0.1}}, {{0.25, 0.6}}, {{0.25, -0.2}}}};
+  const auto distance_to_path = [&](const mesh::Point3 &x)
+  {
+    double d = 1e300;
+    for (unsigned int k = 0; k + 1 < path.size(); ++k)
+    {
+      const double ex = path[k + 1][0] - path[k][0], ey = path[k + 1][1] - path[k][1];
+      const double t = std::clamp(((x[0] - path[k][0]) * ex + (x[1] - path[k][1]) * ey)
+                                    / (ex * ex + ey * ey),
+                                  0.0,
+                                  1.0);
+      d = std::min(d, std::hypot(x[0] - path[k][0] - t * ex, x[1] - path[k][1] - t * ey));
+    }
+    return d;
+  };
+  const double snapping = cut::Cutter::Parameters().snap_fraction * std::sqrt(3.0) / 8;
+  double       farthest = 0;
+  for (unsigned int seed = 0; seed < 12; ++seed)
+  {
+    std::mt19937                           rng(seed);
+    CutFixture                             f(8, rng, vertical(1.2, 0.1));
+    std::uniform_real_distribution<double> noise(-1e-16, 1e-16);
+    for (double &x : f.system->position)
+      x += noise(rng);
+    f.stroke({vertical(1.2, 0.1), vertical(0.25, 0.6), vertical(0.25, -0.2)}, 6);
+    ASSERT_FALSE(::testing::Test::HasFatalFailure());
+    EXPECT_EQ(f.component_volumes().size(), 2u) << "seed " << seed;
+    for (const mesh::BoundaryFace &face : f.mesh.get_boundary_faces())
+      if (face.boundary_id == cut::cut_boundary_id)
+        for (const unsigned int k : mesh::TetMesh::face_vertices[face.face])
+          farthest =
+            std::max(farthest, distance_to_path(f.mesh.vertex(f.mesh.tet(face.tet)[k])));
+  }
+  EXPECT_LE(farthest, snapping * (1 + 1e-9));
+}
+
+
 TEST(CutCutter, RebalancingAfterABladeMotionStaysNearWhatTheMotionChanged)
 {
   // A long stroke in many motions: the particles along the crack are light and are
