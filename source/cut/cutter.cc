@@ -168,25 +168,17 @@ namespace lacerta::cut
       it = forget_crossing(it);
     // The vertices' sides belong to this stroke.
     ++stroke;
-    part.started = false;
+    part.normal = Point{};
   }
 
 
   void
-  Cutter::follow_part(const std::array<std::array<Point, 3>, 2> &swept_triangles,
-                      const Point                               &normal)
+  Cutter::follow_part(const Point &normal)
   {
-    // The middle of the blade before and after the sweep (swept_triangles[0] is
-    // {from.tail, from.head, to.tail}, swept_triangles[1] {to.tail, from.head, to.head}).
-    part.from = scale(0.5, add(swept_triangles[0][0], swept_triangles[0][1]));
-    const Point motion =
-      sub(scale(0.5, add(swept_triangles[1][0], swept_triangles[1][2])), part.from);
-    const double length = norm(motion);
-    part.motion         = length > 0 ? scale(1 / length, motion) : Point{};
-    if (!part.started || dot(part.normal, normal) <= same_part_cosine)
+    // A zero normal (a new stroke) is never the same part.
+    if (dot(part.normal, normal) <= same_part_cosine)
       part.triangles.clear();
-    part.started = true;
-    part.normal  = normal;
+    part.normal = normal;
   }
 
 
@@ -206,8 +198,13 @@ namespace lacerta::cut
                        const double                               distance,
                        const std::array<std::array<Point, 3>, 2> &swept_triangles) const
   {
-    const Point x = position(v);
-    if (dot(sub(x, part.from), part.motion) >= -distance)
+    // The middle of the blade before and after the sweep (swept_triangles[0] is
+    // {from.tail, from.head, to.tail}, swept_triangles[1] {to.tail, from.head, to.head}).
+    const Point x    = position(v);
+    const Point from = scale(0.5, add(swept_triangles[0][0], swept_triangles[0][1]));
+    const Point motion =
+      sub(scale(0.5, add(swept_triangles[1][0], swept_triangles[1][2])), from);
+    if (dot(sub(x, from), motion) >= -distance * norm(motion))
       return true;
     const auto near = [&](const std::array<Point, 3> &t)
     { return mesh::point_triangle_distance(x, t[0], t[1], t[2]) <= distance; };
@@ -493,7 +490,7 @@ namespace lacerta::cut
       return; // the blade moved along itself: it sweeps no surface
     normal         = normalized(normal);
     sweep_triangle = swept_triangles[0];
-    follow_part(swept_triangles, normal);
+    follow_part(normal);
     ++analysis_stamp;
     for (const unsigned int t : candidates)
       for (unsigned int e = 0; e < 6; ++e)
@@ -1311,6 +1308,6 @@ namespace lacerta::cut
     archive.section("cutter");
     archive(current, typical_edge, tree, active, on_surface, on_surface_list);
     archive(side_records, blade_cell_positions, stroke, crossings, crossings_at, adopted);
-    archive(part.started, part.normal, part.from, part.motion, part.triangles);
+    archive(part.normal, part.triangles);
   }
 } // namespace lacerta::cut

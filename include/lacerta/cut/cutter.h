@@ -386,33 +386,30 @@ namespace lacerta::cut
     /**
      * The part of the swept surface the current sweep belongs to: a new part starts
      * where the blade turns by more than 45 degrees from its last sweep (a corner of
-     * the path). `triangles` holds the triangles of its last sweeps before the current
-     * one (deformed, at most `kept_part_sweeps` sweeps), `normal` the unit normal of
-     * the last sweep; `from` and `motion` are the middle of the blade at the start of
-     * the current sweep and its unit motion. `started` is false between strokes.
+     * the path). `normal` is the unit normal of its last sweep (zero between strokes),
+     * `triangles` the triangles of its sweeps before the current one (deformed, at most
+     * `kept_part_sweeps` sweeps).
      */
     struct SurfacePart
     {
-      bool                              started = false;
-      Point                             normal{}, from{}, motion{};
+      Point                             normal{};
       std::vector<std::array<Point, 3>> triangles;
     };
     SurfacePart part;
     /// How many earlier sweeps of the current part `part` keeps.
     static constexpr unsigned int kept_part_sweeps = 8;
-    /// Starts a new part for a sweep of @p swept_triangles with unit normal
-    /// @p normal if the blade turned by more than 45 degrees since its last sweep.
+    /// Starts a new part for a sweep with unit normal @p normal if the blade turned by
+    /// more than 45 degrees since its last sweep (or the stroke begins).
     void
-    follow_part(const std::array<std::array<Point, 3>, 2> &swept_triangles,
-                const Point                               &normal);
+    follow_part(const Point &normal);
     /// Keeps the current sweep's @p swept_triangles in `part`.
     void
     keep_part_sweep(const std::array<std::array<Point, 3>, 2> &swept_triangles);
     /**
      * Whether the current part of the swept surface reaches within @p distance of
-     * vertex @p v (deformed): the vertex lies ahead of the current sweep's start, or
-     * within @p distance of its triangles or of the part's earlier sweeps. A part that
-     * starts at a corner does not reach behind the corner.
+     * vertex @p v (deformed): the vertex lies ahead of the start of the current sweep
+     * @p swept_triangles, or within @p distance of its triangles or of the part's
+     * earlier sweeps. A part that starts at a corner does not reach behind the corner.
      */
     bool
     part_reaches(unsigned int                               v,
