@@ -294,6 +294,7 @@ namespace lacerta::physics
   gershgorin_rows(const ParticleSystem            &system,
                   const double                    *x,
                   const std::vector<unsigned int> &rows,
+                  const std::vector<double>       &weights,
                   GershgorinRowScratch            &scratch,
                   double                          *lambda,
                   unsigned int                    *stiffest_spring)
@@ -313,11 +314,12 @@ namespace lacerta::physics
       const bool coupled = system.free[i] > 0 && system.free[j] > 0 && w.pair_norm[k] > 0;
       const double c =
         coupled ? w.pair_norm[k] / std::sqrt(system.mass[i] * system.mass[j]) : 0.0;
-      for (const unsigned int p : {i, j})
+      for (const auto [p, q] : {std::pair{i, j}, std::pair{j, i}})
         if (is_row(p))
         {
           const unsigned int r = w.row_of[p];
-          w.off_diagonal[r] += c;
+          if (c != 0)
+            w.off_diagonal[r] += weights.empty() ? c : c * weights[q] / weights[p];
           if (w.pair_norm[k] > w.stiffest[r])
           {
             w.stiffest[r]      = w.pair_norm[k];
@@ -360,7 +362,9 @@ namespace lacerta::physics
 
 
   std::vector<double>
-  squared_frequency_bounds(const ParticleSystem &system, const GershgorinTerms &terms)
+  squared_frequency_bounds(const ParticleSystem      &system,
+                           const GershgorinTerms     &terms,
+                           const std::vector<double> &weights)
   {
     const unsigned int  n = system.n_particles();
     std::vector<double> off_diagonal(n, 0.0);
@@ -369,14 +373,24 @@ namespace lacerta::physics
       {
         const unsigned int i = system.springs.a[s], j = system.springs.b[s];
         const double c = terms.coupling[s] / std::sqrt(system.mass[i] * system.mass[j]);
-        off_diagonal[i] += c;
-        off_diagonal[j] += c;
+        off_diagonal[i] += weights.empty() ? c : c * weights[j] / weights[i];
+        off_diagonal[j] += weights.empty() ? c : c * weights[i] / weights[j];
       }
     std::vector<double> lambda(n, 0.0);
     for (unsigned int i = 0; i < n; ++i)
       if (system.free[i] > 0 && system.mass[i] > 0)
         lambda[i] = terms.diagonal[i] / system.mass[i] + off_diagonal[i];
     return lambda;
+  }
+
+
+  std::vector<double>
+  gershgorin_row_weights(const ParticleSystem &system, const GershgorinTerms &terms)
+  {
+    std::vector<double> weights = squared_frequency_bounds(system, terms);
+    for (double &w : weights)
+      w = gershgorin_row_weight(w);
+    return weights;
   }
 
 
@@ -394,10 +408,11 @@ namespace lacerta::physics
   FrequencyBound
   bound_highest_frequency(const ParticleSystem &system)
   {
-    const GershgorinTerms     terms  = gershgorin_terms(system, system.position.data());
-    const std::vector<double> lambda = squared_frequency_bounds(system, terms);
-    FrequencyBound            bound;
-    double                    largest = 0;
+    const GershgorinTerms     terms = gershgorin_terms(system, system.position.data());
+    const std::vector<double> lambda =
+      squared_frequency_bounds(system, terms, gershgorin_row_weights(system, terms));
+    FrequencyBound bound;
+    double         largest = 0;
     for (unsigned int i = 0; i < lambda.size(); ++i)
       if (lambda[i] > largest)
       {

@@ -11,7 +11,8 @@ namespace lacerta::physics
   StabilityBound::compute(const ParticleSystem &system)
   {
     const GershgorinTerms terms = gershgorin_terms(system, system.position.data());
-    lambda                      = squared_frequency_bounds(system, terms);
+    weights                     = gershgorin_row_weights(system, terms);
+    lambda                      = squared_frequency_bounds(system, terms, weights);
     stiffest                    = terms.stiffest_spring;
     build_tree(system.n_particles());
   }
@@ -29,15 +30,49 @@ namespace lacerta::physics
       compute(system);
       return;
     }
-    const unsigned int n = system.n_particles();
+    const unsigned int n      = system.n_particles();
+    const unsigned int before = static_cast<unsigned int>(lambda.size());
     lambda.resize(n, 0.0);
     stiffest.resize(n, 0);
+    weights.resize(n, 1.0);
     if (n > leaves)
       build_tree(n);
-    // A particle's bound depends on its springs and tetrahedra and on its neighbours'
-    // masses: the changed particles and every vertex of their stars are bounded again.
-    ++mark;
     row_mark.resize(n, 0);
+    // A particle's unscaled row, hence its weight, depends on its springs and
+    // tetrahedra and on its neighbours' masses: the changed and appended particles and
+    // every vertex of their stars get new weights.
+    const auto bound_rows = [&](const std::vector<double> &row_weights)
+    {
+      row_lambda.resize(rows.size());
+      row_spring.resize(rows.size());
+      gershgorin_rows(system,
+                      system.position.data(),
+                      rows,
+                      row_weights,
+                      scratch,
+                      row_lambda.data(),
+                      row_spring.data());
+    };
+    add_star_rows(system, changed, before);
+    weighted.assign(rows.begin(), rows.end());
+    bound_rows({});
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      weights[rows[r]] = gershgorin_row_weight(row_lambda[r]);
+    // A scaled row depends on its neighbours' weights too: those particles and every
+    // vertex of their stars are bounded again.
+    add_star_rows(system, weighted, n);
+    bound_rows(weights);
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      set(rows[r], row_lambda[r], row_spring[r]);
+  }
+
+
+  void
+  StabilityBound::add_star_rows(const ParticleSystem            &system,
+                                const std::vector<unsigned int> &particles,
+                                const unsigned int               appended_from)
+  {
+    ++mark;
     rows.clear();
     const auto add_row = [&](const unsigned int v)
     {
@@ -47,23 +82,17 @@ namespace lacerta::physics
         rows.push_back(v);
       }
     };
-    for (const unsigned int p : changed)
+    const auto add_star = [&](const unsigned int p)
     {
       add_row(p);
       for (const unsigned int t : system.mesh->tets_of_vertex(p))
         for (const unsigned int v : system.mesh->tet(t))
           add_row(v);
-    }
-    row_lambda.resize(rows.size());
-    row_spring.resize(rows.size());
-    gershgorin_rows(system,
-                    system.position.data(),
-                    rows,
-                    scratch,
-                    row_lambda.data(),
-                    row_spring.data());
-    for (std::size_t r = 0; r < rows.size(); ++r)
-      set(rows[r], row_lambda[r], row_spring[r]);
+    };
+    for (const unsigned int p : particles)
+      add_star(p);
+    for (unsigned int p = appended_from; p < system.n_particles(); ++p)
+      add_star(p);
   }
 
 
@@ -128,6 +157,6 @@ namespace lacerta::physics
   StabilityBound::serialize(Archive &archive)
   {
     archive.section("stability bound");
-    archive(lambda, stiffest, tree, leaves);
+    archive(lambda, stiffest, weights, tree, leaves);
   }
 } // namespace lacerta::physics

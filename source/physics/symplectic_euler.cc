@@ -52,5 +52,6 @@ namespace lacerta::physics
     "symplectic_euler",
     "Semi-implicit Euler (velocity first, then position): one force "
     "evaluation per step, first order, symplectic, stable up to "
-    "ω·dt < 2 without damping.");
+    "ω·dt < 2 without damping, kept below ω·dt = √2, its 4:1 nonlinear "
+    "resonance.");
 } // namespace lacerta::physics

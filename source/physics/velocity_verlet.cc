@@ -79,5 +79,5 @@ namespace lacerta::physics
     "velocity_verlet",
     "Velocity Verlet (leapfrog): one force evaluation per step, "
     "second order, symplectic, stable up to ω·dt < 2 without "
-    "damping.");
+    "damping, kept below ω·dt = √2, its 4:1 nonlinear resonance.");
 } // namespace lacerta::physics

@@ -234,20 +234,38 @@ TEST(ElementModels, BoundIsAboveTheTrueFrequencyAndStableAtNinetyPercent)
         run->position         = perturbed(run->rest_position(), 2e-3, 3);
         const auto integrator = physics::IntegratorRegistry::create(name);
         integrator->initialize(*run);
-        const double           dt = 0.9 * integrator->critical_time_step(bound, 0, 0);
-        const double           initial = run->kinetic_energy() + run->elastic_energy();
+        double                 dt = 0.9 * integrator->critical_time_step(bound, 0, 0);
         physics::BlowUpMonitor monitor(*run, 1.0);
+        // The largest energy over the first and the last 1000 steps: an unstable mode
+        // grows geometrically, so the last would be far above the first. The energy
+        // itself is not compared with the initial one: symplectic Euler keeps a
+        // modified energy, and the one measured swings by up to 1 / (1 - (ω dt / 2)²)
+        // around it, a factor 5 at 0.9 times the limit.
+        double first = 0, last = 0, time = 0;
         for (unsigned int step = 1; step <= 3000; ++step)
         {
-          integrator->step(*run, step * dt, dt);
+          time += dt;
+          integrator->step(*run, time, dt);
           if (step % 100 == 0)
           {
-            EXPECT_NO_THROW(monitor.check(*run, step, step * dt))
-              << model << ", " << name;
+            EXPECT_NO_THROW(monitor.check(*run, step, time)) << model << ", " << name;
+            // As the simulator does at its checks: the frequency of a nonlinear model
+            // changes with the deformation (the volume springs' at nu = 0 rose by more
+            // than the 1.28 between the bound and the true one at the start, and a
+            // step kept from the start blew up after 3,500 steps).
+            dt = std::min(dt,
+                          0.9
+                            * integrator->critical_time_step(
+                              physics::bound_highest_frequency(*run).omega, 0, 0));
           }
+          const double energy = run->kinetic_energy() + run->elastic_energy();
+          if (step <= 1000)
+            first = std::max(first, energy);
+          else if (step > 2000)
+            last = std::max(last, energy);
         }
-        EXPECT_LT(run->kinetic_energy() + run->elastic_energy(), 1.5 * initial)
-          << model << ", " << name << ", nu " << nu;
+        EXPECT_TRUE(std::isfinite(last)) << model << ", " << name << ", nu " << nu;
+        EXPECT_LT(last, 1.05 * first) << model << ", " << name << ", nu " << nu;
       }
     }
 }

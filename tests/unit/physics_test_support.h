@@ -13,6 +13,8 @@
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/tria.h>
 
+#include <Eigen/Dense>
+
 #include <deque>
 #include <memory>
 #include <string>
@@ -90,4 +92,48 @@ namespace lacerta::test_support
       row[i] = system.free[i] > 0 ? row[i] / system.mass[i] : 0.0;
     return row;
   }
+  /**
+   * The true highest angular eigenfrequency of M⁻¹K at the current positions, from the
+   * dense tangent stiffness (with the geometric term) of the free particles'
+   * springs.
+   */
+  inline double
+  true_highest_frequency(const physics::ParticleSystem &system)
+  {
+    const unsigned int n = system.n_particles();
+    Eigen::MatrixXd    k = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+    const auto        &x = system.position;
+    for (std::size_t s = 0; s < system.springs.size(); ++s)
+    {
+      const unsigned int i = system.springs.a[s], j = system.springs.b[s];
+      Eigen::Vector3d    d(x[3 * j] - x[3 * i],
+                        x[3 * j + 1] - x[3 * i + 1],
+                        x[3 * j + 2] - x[3 * i + 2]);
+      const double       length = d.norm();
+      d /= length;
+      const double    ks = system.springs.stiffness[s];
+      const double    g  = ks * (1 - system.springs.rest_length[s] / length);
+      Eigen::Matrix3d block =
+        (ks - g) * d * d.transpose() + g * Eigen::Matrix3d::Identity();
+      k.block<3, 3>(3 * i, 3 * i) += block;
+      k.block<3, 3>(3 * j, 3 * j) += block;
+      k.block<3, 3>(3 * i, 3 * j) -= block;
+      k.block<3, 3>(3 * j, 3 * i) -= block;
+    }
+    std::vector<unsigned int> free_dofs;
+    for (unsigned int i = 0; i < n; ++i)
+      if (system.free[i] > 0)
+        for (unsigned int d = 0; d < 3; ++d)
+          free_dofs.push_back(3 * i + d);
+    Eigen::MatrixXd a(free_dofs.size(), free_dofs.size());
+    for (std::size_t r = 0; r < free_dofs.size(); ++r)
+      for (std::size_t c = 0; c < free_dofs.size(); ++c)
+        a(r, c) =
+          k(free_dofs[r], free_dofs[c])
+          / std::sqrt(system.mass[free_dofs[r] / 3] * system.mass[free_dofs[c] / 3]);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(a, Eigen::EigenvaluesOnly);
+    return std::sqrt(eigen.eigenvalues().maxCoeff());
+  }
+
+
 } // namespace lacerta::test_support

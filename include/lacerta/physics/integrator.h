@@ -93,9 +93,18 @@ namespace lacerta::physics
   modal_damping(double omega, double mass_damping, double spring_damping);
 
   /**
-   * The stable step of symplectic Euler and velocity Verlet for an oscillator with
-   * angular frequency @p omega and damping rate @p c: dt < (sqrt(c² + 4ω²) - c) / ω²
-   * (2/ω without damping; doc/stability.md derives it).
+   * The linear stability limit of symplectic Euler and velocity Verlet for an
+   * oscillator with angular frequency @p omega and damping rate @p c:
+   * dt < (sqrt(c² + 4ω²) - c) / ω² (2/ω without damping; doc/stability.md derives it).
+   */
+  double
+  symplectic_linear_stability_limit(double omega, double c);
+
+  /**
+   * The step symplectic Euler and velocity Verlet are kept under: the linear limit,
+   * and at most √2/ω, the step of their 4:1 nonlinear resonance (four steps per
+   * numerical period), above which a nonlinear force model can pump energy into its
+   * fastest mode although every linearised mode is stable (doc/stability.md).
    */
   double
   symplectic_critical_time_step(double omega, double c);

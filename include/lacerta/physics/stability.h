@@ -59,11 +59,41 @@ namespace lacerta::physics
   gershgorin_terms(const ParticleSystem &system, const double *positions);
 
   /**
-   * The squares λ_i = ω_i² of particle_frequency_bounds() from the system's
-   * Gershgorin @p terms (0 for constrained or massless particles).
+   * The squared row bounds λ_i from the system's Gershgorin @p terms (0 for
+   * constrained or massless particles), with the rows scaled by the positive
+   * @p weights d (one per particle; empty: all 1):
+   * λ_i = diagonal[i] / m_i + Σ_e coupling[e] / sqrt(m_i m_j) · d_j / d_i.
+   *
+   * This is block Gershgorin applied to D⁻¹ A D, D = diag(d_i I₃), which has the
+   * eigenvalues of A = M^-1/2 K M^-1/2: max_i λ_i bounds the highest eigenvalue for
+   * every choice of positive weights. With all weights 1 these are the rows of
+   * particle_frequency_bounds(); bound_highest_frequency() takes the weights of
+   * gershgorin_row_weight().
    */
   std::vector<double>
-  squared_frequency_bounds(const ParticleSystem &system, const GershgorinTerms &terms);
+  squared_frequency_bounds(const ParticleSystem      &system,
+                           const GershgorinTerms     &terms,
+                           const std::vector<double> &weights = {});
+
+  /**
+   * The weight d_i of a row for squared_frequency_bounds(), from its bound with all
+   * weights 1, @p unscaled_row: that bound itself (1 if it is 0, for a particle
+   * without a row; a NaN stays NaN, so that the bound reports it). Where the rows
+   * differ, the heavy, slow particles next to a light, fast one then take a share of
+   * its coupling terms in proportion to how much lower their rows are: for a light
+   * particle on one spring to a heavy one, the scaled rows are the exact frequency.
+   * A property of a row and its neighbours' rows only, so a local change of the
+   * system changes the weights locally (StabilityBound::update()).
+   */
+  inline double
+  gershgorin_row_weight(const double unscaled_row)
+  {
+    return unscaled_row == 0 ? 1.0 : unscaled_row;
+  }
+
+  /// gershgorin_row_weight() of every particle, from the system's Gershgorin @p terms.
+  std::vector<double>
+  gershgorin_row_weights(const ParticleSystem &system, const GershgorinTerms &terms);
 
   /**
    * Working space of gershgorin_rows() and gershgorin_row_sums(), kept between calls so
@@ -82,17 +112,19 @@ namespace lacerta::physics
   };
 
   /**
-   * The squared bounds λ_i = ω_i² of particle_frequency_bounds() and the stiffest
-   * spring at the particles @p rows only (distinct), from the springs and the force
-   * model's tetrahedra around them at positions @p x: into @p lambda and
-   * @p stiffest_spring, one entry per row. The same values as the computation over
-   * the whole system, to rounding, at a cost that depends on the rows' stars only.
-   * Needs `system.mesh` with local updates (its edges are the springs).
+   * The squared row bounds λ_i of squared_frequency_bounds() with @p weights (one per
+   * particle, or empty: all 1) and the stiffest spring at the particles @p rows only
+   * (distinct), from the springs and the force model's tetrahedra around them at
+   * positions @p x: into @p lambda and @p stiffest_spring, one entry per row. The
+   * same values as the computation over the whole system, to rounding, at a cost
+   * that depends on the rows' stars only. Needs `system.mesh` with local updates (its
+   * edges are the springs).
    */
   void
   gershgorin_rows(const ParticleSystem            &system,
                   const double                    *x,
                   const std::vector<unsigned int> &rows,
+                  const std::vector<double>       &weights,
                   GershgorinRowScratch            &scratch,
                   double                          *lambda,
                   unsigned int                    *stiffest_spring);
@@ -113,7 +145,9 @@ namespace lacerta::physics
 
   /**
    * Bounds the highest eigenvalue of M^-1/2 K M^-1/2 by block Gershgorin over the free
-   * particles: λ ≤ max_i [λ_max(Σ_e K_e) / m_i + Σ_e ||K_e|| / sqrt(m_i m_j)], with the
+   * particles with scaled rows: λ ≤ max_i [λ_max(Σ_e K_e) / m_i
+   * + Σ_e ||K_e|| / sqrt(m_i m_j) · d_j / d_i], the weights d those of
+   * gershgorin_row_weight() (squared_frequency_bounds()), with the
    * tangent stiffness of each spring at the current positions,
    * K_e = k n nᵀ + k (1 - L0/L)(I - n nᵀ), whose geometric part matters for strongly
    * compressed springs. A force model per tetrahedron adds its element stiffness
@@ -123,8 +157,8 @@ namespace lacerta::physics
   bound_highest_frequency(const ParticleSystem &system);
 
   /**
-   * The block Gershgorin bound of bound_highest_frequency() at every particle (rad/s;
-   * 0 for constrained or massless ones): the highest frequency of the springs around it.
+   * The block Gershgorin row bound of every particle with all weights 1 (rad/s; 0 for
+   * constrained or massless ones): the highest frequency of the springs around it.
    */
   std::vector<double>
   particle_frequency_bounds(const ParticleSystem &system);

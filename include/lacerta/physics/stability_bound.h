@@ -17,9 +17,10 @@ namespace lacerta::physics
   class ParticleSystem;
 
   /**
-   * The block Gershgorin bound of bound_highest_frequency(), kept per particle so that
-   * a local change of the system (a cut, a tear) costs a bound over the changed
-   * particles' stars, not over the whole system: nothing global per cut.
+   * The scaled block Gershgorin bound of bound_highest_frequency(), kept per particle
+   * with the weights of its rows so that a local change of the system (a cut, a tear)
+   * costs a bound over the changed particles' stars and their neighbours' stars, not
+   * over the whole system: nothing global per cut.
    *
    * Between two compute(), a particle's bound is that of the positions it was last
    * computed at, as the bound of bound_highest_frequency() is that of the positions
@@ -34,9 +35,10 @@ namespace lacerta::physics
 
     /**
      * Updates the bound after a local change of the system: the particles listed in
-     * @p changed (ParticleSystem::changed_particles(), repeats allowed) and their
-     * neighbours are bounded again at the current positions, the others keep their
-     * bound; appended particles join. Computes everything if the system has no mesh
+     * @p changed (ParticleSystem::changed_particles(), repeats allowed), the appended
+     * ones and their neighbours get new weights (gershgorin_row_weight()), and every
+     * row that reads one of them is bounded again at the current positions; the
+     * others keep their bound. Computes everything if the system has no mesh
      * with local updates whose edges are its springs, if every particle counts as
      * changed
      * (ParticleSystem::all_particles_changed()), or if compute() was never called.
@@ -56,6 +58,13 @@ namespace lacerta::physics
       return lambda[i];
     }
 
+    /// The weight d_i of every particle's row (squared_frequency_bounds()).
+    const std::vector<double> &
+    row_weights() const
+    {
+      return weights;
+    }
+
     /// Writes or reads the state for a checkpoint (see lacerta::Archive).
     void
     serialize(Archive &archive);
@@ -65,6 +74,13 @@ namespace lacerta::physics
     /// particles.
     void
     build_tree(unsigned int n);
+
+    /// Makes `rows` the distinct vertices of the stars of @p particles and of the
+    /// particles from @p appended_from on.
+    void
+    add_star_rows(const ParticleSystem            &system,
+                  const std::vector<unsigned int> &particles,
+                  unsigned int                     appended_from);
 
     /// Sets particle @p i's bound and updates the tree of maxima above it.
     void
@@ -77,6 +93,9 @@ namespace lacerta::physics
     /// λ_i = ω_i² and the stiffest spring of every particle.
     std::vector<double>       lambda;
     std::vector<unsigned int> stiffest;
+    /// The weight of every particle's row: gershgorin_row_weight() of its row with
+    /// all weights 1.
+    std::vector<double> weights;
     /// A tree of maxima: node k holds the best particle of its two children, the
     /// leaves (from `leaves` on) the particles; `none` past the last particle.
     std::vector<unsigned int>     tree;
@@ -85,7 +104,7 @@ namespace lacerta::physics
 
     /// The rows of an update (the changed particles and their neighbours), marked
     /// in `row_mark` with the update's `mark`.
-    std::vector<unsigned int> rows, row_mark;
+    std::vector<unsigned int> rows, row_mark, weighted;
     unsigned int              mark = 0;
     std::vector<double>       row_lambda;
     std::vector<unsigned int> row_spring;
