@@ -294,7 +294,8 @@ namespace lacerta::physics
   gershgorin_rows(const ParticleSystem            &system,
                   const double                    *x,
                   const std::vector<unsigned int> &rows,
-                  const std::vector<double>       &weights,
+                  const std::size_t                n_reweighted,
+                  std::vector<double>             &weights,
                   GershgorinRowScratch            &scratch,
                   double                          *lambda,
                   unsigned int                    *stiffest_spring)
@@ -302,24 +303,50 @@ namespace lacerta::physics
     const SpringSet      &springs = system.springs;
     GershgorinRowScratch &w       = scratch;
     gather_row_terms(system, x, rows, w);
-    const auto is_row = [&](const unsigned int p) { return w.row_stamp[p] == w.stamp; };
-    // The rows, as squared_frequency_bounds() makes them from gershgorin_terms().
+    const auto is_row  = [&](const unsigned int p) { return w.row_stamp[p] == w.stamp; };
+    const auto has_row = [&](const unsigned int i)
+    { return system.free[i] > 0 && system.mass[i] > 0; };
+    // The rows, as squared_frequency_bounds() makes them from gershgorin_terms(): the
+    // diagonal terms, the coupling of each spring, then the sum of the couplings with
+    // all weights 1 for the rows weighted anew, and weighted for every row.
+    w.diagonal.resize(rows.size());
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      w.diagonal[r] =
+        has_row(rows[r]) ? largest_eigenvalue(w.blocks[r]) / system.mass[rows[r]] : 0.0;
+    w.coupling.resize(w.springs.size());
+    for (std::size_t k = 0; k < w.springs.size(); ++k)
+    {
+      const unsigned int s = w.springs[k], i = springs.a[s], j = springs.b[s];
+      const bool coupled = system.free[i] > 0 && system.free[j] > 0 && w.pair_norm[k] > 0;
+      w.coupling[k] =
+        coupled ? w.pair_norm[k] / std::sqrt(system.mass[i] * system.mass[j]) : 0.0;
+    }
     w.off_diagonal.assign(rows.size(), 0.0);
+    if (n_reweighted > 0)
+    {
+      for (std::size_t k = 0; k < w.springs.size(); ++k)
+        for (const unsigned int p : {springs.a[w.springs[k]], springs.b[w.springs[k]]})
+          if (is_row(p) && w.row_of[p] < n_reweighted)
+            w.off_diagonal[w.row_of[p]] += w.coupling[k];
+      for (std::size_t r = 0; r < n_reweighted; ++r)
+      {
+        weights[rows[r]] = gershgorin_row_weight(
+          has_row(rows[r]) ? w.diagonal[r] + w.off_diagonal[r] : 0.0);
+        w.off_diagonal[r] = 0;
+      }
+    }
     w.stiffest.assign(rows.size(), 0.0);
     for (std::size_t r = 0; r < rows.size(); ++r)
       stiffest_spring[r] = 0;
     for (std::size_t k = 0; k < w.springs.size(); ++k)
     {
       const unsigned int s = w.springs[k], i = springs.a[s], j = springs.b[s];
-      const bool coupled = system.free[i] > 0 && system.free[j] > 0 && w.pair_norm[k] > 0;
-      const double c =
-        coupled ? w.pair_norm[k] / std::sqrt(system.mass[i] * system.mass[j]) : 0.0;
       for (const auto [p, q] : {std::pair{i, j}, std::pair{j, i}})
         if (is_row(p))
         {
           const unsigned int r = w.row_of[p];
-          if (c != 0)
-            w.off_diagonal[r] += weights.empty() ? c : c * weights[q] / weights[p];
+          if (w.coupling[k] != 0)
+            w.off_diagonal[r] += w.coupling[k] * weights[q] / weights[p];
           if (w.pair_norm[k] > w.stiffest[r])
           {
             w.stiffest[r]      = w.pair_norm[k];
@@ -328,12 +355,7 @@ namespace lacerta::physics
         }
     }
     for (std::size_t r = 0; r < rows.size(); ++r)
-    {
-      const unsigned int i = rows[r];
-      lambda[r]            = system.free[i] > 0 && system.mass[i] > 0
-                               ? largest_eigenvalue(w.blocks[r]) / system.mass[i] + w.off_diagonal[r]
-                               : 0.0;
-    }
+      lambda[r] = has_row(rows[r]) ? w.diagonal[r] + w.off_diagonal[r] : 0.0;
   }
 
 

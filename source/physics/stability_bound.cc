@@ -38,42 +38,38 @@ namespace lacerta::physics
     if (n > leaves)
       build_tree(n);
     row_mark.resize(n, 0);
-    // A particle's unscaled row, hence its weight, depends on its springs and
-    // tetrahedra and on its neighbours' masses: the changed and appended particles and
-    // every vertex of their stars get new weights.
-    const auto bound_rows = [&](const std::vector<double> &row_weights)
-    {
-      row_lambda.resize(rows.size());
-      row_spring.resize(rows.size());
-      gershgorin_rows(system,
-                      system.position.data(),
-                      rows,
-                      row_weights,
-                      scratch,
-                      row_lambda.data(),
-                      row_spring.data());
-    };
-    add_star_rows(system, changed, before);
-    weighted.assign(rows.begin(), rows.end());
-    bound_rows({});
-    for (std::size_t r = 0; r < rows.size(); ++r)
-      weights[rows[r]] = gershgorin_row_weight(row_lambda[r]);
-    // A scaled row depends on its neighbours' weights too: those particles and every
-    // vertex of their stars are bounded again.
-    add_star_rows(system, weighted, n);
-    bound_rows(weights);
+    // A particle's row with all weights 1, hence its weight, depends on its springs
+    // and tetrahedra and on its neighbours' masses: the changed and appended particles
+    // and every vertex of their stars get new weights. A weighted row reads its
+    // neighbours' weights: those particles and every vertex of their stars are bounded
+    // again, in one pass.
+    ++mark;
+    rows.clear();
+    for (const unsigned int p : changed)
+      add_star(system, p);
+    for (unsigned int p = before; p < n; ++p)
+      add_star(system, p);
+    const std::size_t n_reweighted = rows.size();
+    for (std::size_t r = 0; r < n_reweighted; ++r)
+      add_star(system, rows[r]);
+    row_lambda.resize(rows.size());
+    row_spring.resize(rows.size());
+    gershgorin_rows(system,
+                    system.position.data(),
+                    rows,
+                    n_reweighted,
+                    weights,
+                    scratch,
+                    row_lambda.data(),
+                    row_spring.data());
     for (std::size_t r = 0; r < rows.size(); ++r)
       set(rows[r], row_lambda[r], row_spring[r]);
   }
 
 
   void
-  StabilityBound::add_star_rows(const ParticleSystem            &system,
-                                const std::vector<unsigned int> &particles,
-                                const unsigned int               appended_from)
+  StabilityBound::add_star(const ParticleSystem &system, const unsigned int p)
   {
-    ++mark;
-    rows.clear();
     const auto add_row = [&](const unsigned int v)
     {
       if (row_mark[v] != mark)
@@ -82,17 +78,10 @@ namespace lacerta::physics
         rows.push_back(v);
       }
     };
-    const auto add_star = [&](const unsigned int p)
-    {
-      add_row(p);
-      for (const unsigned int t : system.mesh->tets_of_vertex(p))
-        for (const unsigned int v : system.mesh->tet(t))
-          add_row(v);
-    };
-    for (const unsigned int p : particles)
-      add_star(p);
-    for (unsigned int p = appended_from; p < system.n_particles(); ++p)
-      add_star(p);
+    add_row(p);
+    for (const unsigned int t : system.mesh->tets_of_vertex(p))
+      for (const unsigned int v : system.mesh->tet(t))
+        add_row(v);
   }
 
 

@@ -109,22 +109,28 @@ namespace lacerta::physics
     std::vector<unsigned int>          tets, springs;
     std::vector<std::array<double, 6>> blocks;
     std::vector<double>                pair_norm, off_diagonal, stiffest;
+    /// The rows' diagonal terms λ_max(Σ_e K_e) / m_i and the springs' couplings
+    /// ||K_e|| / sqrt(m_i m_j).
+    std::vector<double> diagonal, coupling;
   };
 
   /**
    * The squared row bounds λ_i of squared_frequency_bounds() with @p weights (one per
-   * particle, or empty: all 1) and the stiffest spring at the particles @p rows only
-   * (distinct), from the springs and the force model's tetrahedra around them at
-   * positions @p x: into @p lambda and @p stiffest_spring, one entry per row. The
-   * same values as the computation over the whole system, to rounding, at a cost
-   * that depends on the rows' stars only. Needs `system.mesh` with local updates (its
-   * edges are the springs).
+   * particle) and the stiffest spring at the particles @p rows only (distinct), from
+   * the springs and the force model's tetrahedra around them at positions @p x: into
+   * @p lambda and @p stiffest_spring, one entry per row. The first @p n_reweighted
+   * rows get their weights anew first (gershgorin_row_weight() of their rows with all
+   * weights 1), so @p rows must hold every neighbour of those, whose rows read them.
+   * The same values as the computation over the whole system with those weights, to
+   * rounding, at a cost that depends on the rows' stars only. Needs `system.mesh`
+   * with local updates (its edges are the springs).
    */
   void
   gershgorin_rows(const ParticleSystem            &system,
                   const double                    *x,
                   const std::vector<unsigned int> &rows,
-                  const std::vector<double>       &weights,
+                  std::size_t                      n_reweighted,
+                  std::vector<double>             &weights,
                   GershgorinRowScratch            &scratch,
                   double                          *lambda,
                   unsigned int                    *stiffest_spring);

@@ -75,12 +75,10 @@ namespace lacerta::physics
     void
     build_tree(unsigned int n);
 
-    /// Makes `rows` the distinct vertices of the stars of @p particles and of the
-    /// particles from @p appended_from on.
+    /// Appends to `rows` particle @p p and the vertices of its star that it does not
+    /// hold yet (those marked with `mark`).
     void
-    add_star_rows(const ParticleSystem            &system,
-                  const std::vector<unsigned int> &particles,
-                  unsigned int                     appended_from);
+    add_star(const ParticleSystem &system, unsigned int p);
 
     /// Sets particle @p i's bound and updates the tree of maxima above it.
     void
@@ -104,7 +102,7 @@ namespace lacerta::physics
 
     /// The rows of an update (the changed particles and their neighbours), marked
     /// in `row_mark` with the update's `mark`.
-    std::vector<unsigned int> rows, row_mark, weighted;
+    std::vector<unsigned int> rows, row_mark;
     unsigned int              mark = 0;
     std::vector<double>       row_lambda;
     std::vector<unsigned int> row_spring;
