@@ -71,14 +71,17 @@ namespace lacerta::physics
     /**
      * The tangent stiffness K_e = (k - g) n nᵀ + g I of spring @p s at positions @p x
      * (k its stiffness times @p scale, g = k (1 - L0/L) the geometric stiffness) as a
-     * symmetric block, and in @p norm the bound max(k, |g|) of ||K_e||.
+     * symmetric block, in @p norm the bound max(k, |g|) of ||K_e||, and in
+     * @p positive the block P_e = (k - g⁺) n nᵀ + g⁺ I, g⁺ = max(g, 0), with
+     * K_e ≤ P_e and P_e positive semi-definite.
      */
     std::array<double, 6>
-    spring_tangent_block(const SpringSet  &springs,
-                         const std::size_t s,
-                         const double     *x,
-                         const double      scale,
-                         double           &norm)
+    spring_tangent_block(const SpringSet       &springs,
+                         const std::size_t      s,
+                         const double          *x,
+                         const double           scale,
+                         double                &norm,
+                         std::array<double, 6> &positive)
     {
       const unsigned int i = springs.a[s], j = springs.b[s];
       double             d[3]   = {x[3 * j] - x[3 * i],
@@ -90,6 +93,13 @@ namespace lacerta::physics
       const double k         = scale * springs.stiffness[s];
       const double geometric = k * (1.0 - springs.rest_length[s] / length);
       norm                   = std::max(k, std::abs(geometric));
+      const double g         = std::max(geometric, 0.0);
+      positive               = {(k - g) * d[0] * d[0] + g,
+                                (k - g) * d[1] * d[1] + g,
+                                (k - g) * d[2] * d[2] + g,
+                                (k - g) * d[0] * d[1],
+                                (k - g) * d[0] * d[2],
+                                (k - g) * d[1] * d[2]};
       return {(k - geometric) * d[0] * d[0] + geometric,
               (k - geometric) * d[1] * d[1] + geometric,
               (k - geometric) * d[2] * d[2] + geometric,
@@ -142,6 +152,33 @@ namespace lacerta::physics
       return system.has_force_model() ? system.force_model().spring_stiffness_scale()
                                       : 1.0;
     }
+
+
+    /**
+     * Adds the terms of the spring between row @p p and particle @p q to row p of the
+     * weighted bound (weighted_frequency_bounds()): (1 + t) P_e to the row's @p block,
+     * t = sqrt(m_p / m_q) d_q / d_p if both ends are free (0 if q is held), and the
+     * norm @p element_norm of the force model's off-diagonal block on the edge, over
+     * sqrt(m_p m_q) times d_q / d_p, to @p off_diagonal.
+     */
+    void
+    add_weighted_spring_terms(const ParticleSystem        &system,
+                              const unsigned int           p,
+                              const unsigned int           q,
+                              const std::vector<double>   &weights,
+                              const std::array<double, 6> &positive,
+                              const double                 element_norm,
+                              std::array<double, 6>       &block,
+                              double                      &off_diagonal)
+    {
+      const bool   coupled = system.free[p] > 0 && system.free[q] > 0;
+      const double ratio   = coupled ? weights[q] / weights[p] : 0.0;
+      const double t = coupled ? std::sqrt(system.mass[p] / system.mass[q]) * ratio : 0.0;
+      for (unsigned int c = 0; c < 6; ++c)
+        block[c] += (1 + t) * positive[c];
+      if (coupled && element_norm > 0)
+        off_diagonal += element_norm / std::sqrt(system.mass[p] * system.mass[q]) * ratio;
+    }
   } // namespace
 
 
@@ -155,15 +192,19 @@ namespace lacerta::physics
     const double                       scale = spring_scale(system);
     std::vector<std::array<double, 6>> blocks(n, std::array<double, 6>{});
     std::vector<double>                pair_norm(springs.size(), 0.0);
+    std::vector<double>                element_norm(springs.size(), 0.0);
     GershgorinTerms                    terms;
     terms.diagonal.assign(n, 0.0);
     terms.coupling.assign(springs.size(), 0.0);
     terms.stiffest_spring.assign(n, 0);
+    terms.spring_block.resize(springs.size());
+    terms.element_block.assign(n, std::array<double, 6>{});
+    terms.element_coupling.assign(springs.size(), 0.0);
 
     for (std::size_t s = 0; s < springs.size(); ++s)
     {
       const std::array<double, 6> block =
-        spring_tangent_block(springs, s, x, scale, pair_norm[s]);
+        spring_tangent_block(springs, s, x, scale, pair_norm[s], terms.spring_block[s]);
       add_block(blocks[springs.a[s]], block);
       add_block(blocks[springs.b[s]], block);
     }
@@ -177,9 +218,15 @@ namespace lacerta::physics
           element_terms(
             K,
             [&](unsigned int a, const std::array<double, 6> &b)
-            { add_block(blocks[tet[a]], b); },
+            {
+              add_block(blocks[tet[a]], b);
+              add_block(terms.element_block[tet[a]], b);
+            },
             [&](unsigned int e, double norm)
-            { pair_norm[system.mesh->tet_edges(t)[e]] += norm; });
+            {
+              pair_norm[system.mesh->tet_edges(t)[e]] += norm;
+              element_norm[system.mesh->tet_edges(t)[e]] += norm;
+            });
         });
 
     std::vector<double> stiffest(n, 0.0);
@@ -187,7 +234,10 @@ namespace lacerta::physics
     {
       const unsigned int i = springs.a[s], j = springs.b[s];
       if (system.free[i] > 0 && system.free[j] > 0)
-        terms.coupling[s] = pair_norm[s];
+      {
+        terms.coupling[s]         = pair_norm[s];
+        terms.element_coupling[s] = element_norm[s];
+      }
       for (const unsigned int p : {i, j})
         if (pair_norm[s] > stiffest[p])
         {
@@ -253,13 +303,16 @@ namespace lacerta::physics
       for (std::size_t k = 0; k < w.springs.size(); ++k)
         w.spring_of[w.springs[k]] = static_cast<unsigned int>(k);
       w.blocks.assign(rows.size(), std::array<double, 6>{});
+      w.element_blocks.assign(rows.size(), std::array<double, 6>{});
       w.pair_norm.assign(w.springs.size(), 0.0);
+      w.element_norm.assign(w.springs.size(), 0.0);
+      w.spring_blocks.resize(w.springs.size());
       const double scale = spring_scale(system);
       for (std::size_t k = 0; k < w.springs.size(); ++k)
       {
         const unsigned int          s = w.springs[k];
         const std::array<double, 6> block =
-          spring_tangent_block(springs, s, x, scale, w.pair_norm[k]);
+          spring_tangent_block(springs, s, x, scale, w.pair_norm[k], w.spring_blocks[k]);
         for (const unsigned int p : {springs.a[s], springs.b[s]})
           if (is_row(p))
             add_block(w.blocks[w.row_of[p]], block);
@@ -277,13 +330,19 @@ namespace lacerta::physics
               [&](unsigned int a, const std::array<double, 6> &b)
               {
                 if (is_row(tet[a]))
+                {
                   add_block(w.blocks[w.row_of[tet[a]]], b);
+                  add_block(w.element_blocks[w.row_of[tet[a]]], b);
+                }
               },
               [&](unsigned int e, double norm)
               {
                 const unsigned int s = mesh.tet_edges(t)[e];
                 if (w.spring_stamp[s] == w.stamp)
+                {
                   w.pair_norm[w.spring_of[s]] += norm;
+                  w.element_norm[w.spring_of[s]] += norm;
+                }
               });
           });
     }
@@ -306,35 +365,31 @@ namespace lacerta::physics
     const auto is_row  = [&](const unsigned int p) { return w.row_stamp[p] == w.stamp; };
     const auto has_row = [&](const unsigned int i)
     { return system.free[i] > 0 && system.mass[i] > 0; };
-    // The rows, as squared_frequency_bounds() makes them from gershgorin_terms(): the
-    // diagonal terms, the coupling of each spring, then the sum of the couplings with
-    // all weights 1 for the rows weighted anew, and weighted for every row.
-    w.diagonal.resize(rows.size());
-    for (std::size_t r = 0; r < rows.size(); ++r)
+    // The weights of the first rows: their block Gershgorin rows, as
+    // squared_frequency_bounds() makes them from gershgorin_terms().
+    w.diagonal.resize(n_reweighted);
+    w.off_diagonal.assign(rows.size(), 0.0);
+    for (std::size_t r = 0; r < n_reweighted; ++r)
       w.diagonal[r] =
         has_row(rows[r]) ? largest_eigenvalue(w.blocks[r]) / system.mass[rows[r]] : 0.0;
-    w.coupling.resize(w.springs.size());
-    for (std::size_t k = 0; k < w.springs.size(); ++k)
+    for (std::size_t k = 0; k < w.springs.size() && n_reweighted > 0; ++k)
     {
       const unsigned int s = w.springs[k], i = springs.a[s], j = springs.b[s];
-      const bool coupled = system.free[i] > 0 && system.free[j] > 0 && w.pair_norm[k] > 0;
-      w.coupling[k] =
-        coupled ? w.pair_norm[k] / std::sqrt(system.mass[i] * system.mass[j]) : 0.0;
+      if (!(system.free[i] > 0 && system.free[j] > 0 && w.pair_norm[k] > 0))
+        continue;
+      const double c = w.pair_norm[k] / std::sqrt(system.mass[i] * system.mass[j]);
+      for (const unsigned int p : {i, j})
+        if (is_row(p) && w.row_of[p] < n_reweighted)
+          w.off_diagonal[w.row_of[p]] += c;
     }
-    w.off_diagonal.assign(rows.size(), 0.0);
-    if (n_reweighted > 0)
+    for (std::size_t r = 0; r < n_reweighted; ++r)
     {
-      for (std::size_t k = 0; k < w.springs.size(); ++k)
-        for (const unsigned int p : {springs.a[w.springs[k]], springs.b[w.springs[k]]})
-          if (is_row(p) && w.row_of[p] < n_reweighted)
-            w.off_diagonal[w.row_of[p]] += w.coupling[k];
-      for (std::size_t r = 0; r < n_reweighted; ++r)
-      {
-        weights[rows[r]] = gershgorin_row_weight(
-          has_row(rows[r]) ? w.diagonal[r] + w.off_diagonal[r] : 0.0);
-        w.off_diagonal[r] = 0;
-      }
+      weights[rows[r]] =
+        gershgorin_row_weight(has_row(rows[r]) ? w.diagonal[r] + w.off_diagonal[r] : 0.0);
+      w.off_diagonal[r] = 0;
     }
+    // The weighted rows, as weighted_frequency_bounds() makes them: the element
+    // blocks, the springs' positive parts and the element couplings.
     w.stiffest.assign(rows.size(), 0.0);
     for (std::size_t r = 0; r < rows.size(); ++r)
       stiffest_spring[r] = 0;
@@ -345,8 +400,14 @@ namespace lacerta::physics
         if (is_row(p))
         {
           const unsigned int r = w.row_of[p];
-          if (w.coupling[k] != 0)
-            w.off_diagonal[r] += w.coupling[k] * weights[q] / weights[p];
+          add_weighted_spring_terms(system,
+                                    p,
+                                    q,
+                                    weights,
+                                    w.spring_blocks[k],
+                                    w.element_norm[k],
+                                    w.element_blocks[r],
+                                    w.off_diagonal[r]);
           if (w.pair_norm[k] > w.stiffest[r])
           {
             w.stiffest[r]      = w.pair_norm[k];
@@ -355,7 +416,10 @@ namespace lacerta::physics
         }
     }
     for (std::size_t r = 0; r < rows.size(); ++r)
-      lambda[r] = has_row(rows[r]) ? w.diagonal[r] + w.off_diagonal[r] : 0.0;
+      lambda[r] = has_row(rows[r])
+                    ? largest_eigenvalue(w.element_blocks[r]) / system.mass[rows[r]]
+                        + w.off_diagonal[r]
+                    : 0.0;
   }
 
 
@@ -384,9 +448,7 @@ namespace lacerta::physics
 
 
   std::vector<double>
-  squared_frequency_bounds(const ParticleSystem      &system,
-                           const GershgorinTerms     &terms,
-                           const std::vector<double> &weights)
+  squared_frequency_bounds(const ParticleSystem &system, const GershgorinTerms &terms)
   {
     const unsigned int  n = system.n_particles();
     std::vector<double> off_diagonal(n, 0.0);
@@ -395,13 +457,42 @@ namespace lacerta::physics
       {
         const unsigned int i = system.springs.a[s], j = system.springs.b[s];
         const double c = terms.coupling[s] / std::sqrt(system.mass[i] * system.mass[j]);
-        off_diagonal[i] += weights.empty() ? c : c * weights[j] / weights[i];
-        off_diagonal[j] += weights.empty() ? c : c * weights[i] / weights[j];
+        off_diagonal[i] += c;
+        off_diagonal[j] += c;
       }
     std::vector<double> lambda(n, 0.0);
     for (unsigned int i = 0; i < n; ++i)
       if (system.free[i] > 0 && system.mass[i] > 0)
         lambda[i] = terms.diagonal[i] / system.mass[i] + off_diagonal[i];
+    return lambda;
+  }
+
+
+  std::vector<double>
+  weighted_frequency_bounds(const ParticleSystem      &system,
+                            const GershgorinTerms     &terms,
+                            const std::vector<double> &weights)
+  {
+    const unsigned int                 n      = system.n_particles();
+    std::vector<std::array<double, 6>> blocks = terms.element_block;
+    std::vector<double>                off_diagonal(n, 0.0);
+    for (std::size_t s = 0; s < system.springs.size(); ++s)
+    {
+      const unsigned int i = system.springs.a[s], j = system.springs.b[s];
+      for (const auto [p, q] : {std::pair{i, j}, std::pair{j, i}})
+        add_weighted_spring_terms(system,
+                                  p,
+                                  q,
+                                  weights,
+                                  terms.spring_block[s],
+                                  terms.element_coupling[s],
+                                  blocks[p],
+                                  off_diagonal[p]);
+    }
+    std::vector<double> lambda(n, 0.0);
+    for (unsigned int i = 0; i < n; ++i)
+      if (system.free[i] > 0 && system.mass[i] > 0)
+        lambda[i] = largest_eigenvalue(blocks[i]) / system.mass[i] + off_diagonal[i];
     return lambda;
   }
 
@@ -432,7 +523,7 @@ namespace lacerta::physics
   {
     const GershgorinTerms     terms = gershgorin_terms(system, system.position.data());
     const std::vector<double> lambda =
-      squared_frequency_bounds(system, terms, gershgorin_row_weights(system, terms));
+      weighted_frequency_bounds(system, terms, gershgorin_row_weights(system, terms));
     FrequencyBound bound;
     double         largest = 0;
     for (unsigned int i = 0; i < lambda.size(); ++i)

@@ -12,7 +12,7 @@ namespace lacerta::physics
   {
     const GershgorinTerms terms = gershgorin_terms(system, system.position.data());
     weights                     = gershgorin_row_weights(system, terms);
-    lambda                      = squared_frequency_bounds(system, terms, weights);
+    lambda                      = weighted_frequency_bounds(system, terms, weights);
     stiffest                    = terms.stiffest_spring;
     build_tree(system.n_particles());
   }

@@ -79,12 +79,13 @@ TEST(Stability, BoundIsAboveTheTrueFrequencyAndWithinFactorTwo)
 }
 
 
-TEST(Stability, ScaledRowsBoundTheFrequencyForEveryPositiveWeightAndScalingLowersThem)
+TEST(Stability, WeightedRowsBoundTheFrequencyForEveryPositiveWeightAndLowerGershgorin)
 {
-  // Block Gershgorin on D^-1 A D: any positive row weights give a bound above the true
-  // frequency (the local update relies on it, whatever weights it chooses), and the
-  // weights of gershgorin_row_weight() give a lower one than all weights 1. Random masses
-  // (a factor 100 apart, as next to a cut) and random weights spanning 10^6.
+  // The weighted rows bound the true frequency for any positive weights (the local
+  // update relies on it, whatever weights it keeps), and the weights of
+  // gershgorin_row_weight() give a lower bound than block Gershgorin with all weights
+  // 1. Random masses (a factor 100 apart, as next to a cut) and random weights
+  // spanning 10^6.
   std::mt19937                           random(3);
   std::uniform_real_distribution<double> log_weight(-3, 3), log_mass(-1, 1);
   unsigned int                           n_lowered = 0, n_cases = 0;
@@ -104,12 +105,10 @@ TEST(Stability, ScaledRowsBoundTheFrequencyForEveryPositiveWeightAndScalingLower
       const double                   true_omega = true_highest_frequency(*system);
       const physics::GershgorinTerms terms =
         physics::gershgorin_terms(*system, system->position.data());
+      const auto largest = [](const std::vector<double> &lambda)
+      { return std::sqrt(*std::max_element(lambda.begin(), lambda.end())); };
       const auto highest = [&](const std::vector<double> &weights)
-      {
-        const std::vector<double> lambda =
-          physics::squared_frequency_bounds(*system, terms, weights);
-        return std::sqrt(*std::max_element(lambda.begin(), lambda.end()));
-      };
+      { return largest(physics::weighted_frequency_bounds(*system, terms, weights)); };
       for (unsigned int trial = 0; trial < 20; ++trial)
       {
         std::vector<double> weights(system->n_particles());
@@ -117,7 +116,7 @@ TEST(Stability, ScaledRowsBoundTheFrequencyForEveryPositiveWeightAndScalingLower
           w = std::pow(10.0, log_weight(random));
         EXPECT_GE(highest(weights), true_omega * (1 - 1e-12)) << "n = " << n;
       }
-      const double plain  = highest({});
+      const double plain  = largest(physics::squared_frequency_bounds(*system, terms));
       const double scaled = highest(physics::gershgorin_row_weights(*system, terms));
       EXPECT_GE(scaled, true_omega * (1 - 1e-12)) << "n = " << n;
       EXPECT_LE(scaled, plain * (1 + 1e-12)) << "n = " << n;

@@ -59,7 +59,7 @@ namespace lacerta
           for (const double w : bound.row_weights())
             ASSERT_TRUE(w > 0 && std::isfinite(w)) << model << ", motion " << k;
           const std::vector<double> whole =
-            physics::squared_frequency_bounds(system, terms, bound.row_weights());
+            physics::weighted_frequency_bounds(system, terms, bound.row_weights());
           const std::vector<double> plain =
             physics::squared_frequency_bounds(system, terms);
           double highest = 0, highest_plain = 0;

@@ -44,6 +44,14 @@ namespace lacerta::physics
     std::vector<double> coupling;
     /// The stiffest spring at each particle.
     std::vector<unsigned int> stiffest_spring;
+    /// The positive part P_e = k n nᵀ + max(g, 0) (I - n nᵀ) of each spring's tangent
+    /// stiffness (g its geometric stiffness), xx, yy, zz, xy, xz, yz.
+    std::vector<std::array<double, 6>> spring_block;
+    /// The sum of the force model's diagonal element blocks at each particle.
+    std::vector<std::array<double, 6>> element_block;
+    /// The norms of the force model's off-diagonal blocks on each spring's edge whose
+    /// ends are both free, 0 otherwise.
+    std::vector<double> element_coupling;
   };
 
   /**
@@ -59,29 +67,44 @@ namespace lacerta::physics
   gershgorin_terms(const ParticleSystem &system, const double *positions);
 
   /**
-   * The squared row bounds λ_i from the system's Gershgorin @p terms (0 for
-   * constrained or massless particles), with the rows scaled by the positive
-   * @p weights d (one per particle; empty: all 1):
-   * λ_i = diagonal[i] / m_i + Σ_e coupling[e] / sqrt(m_i m_j) · d_j / d_i.
-   *
-   * This is block Gershgorin applied to D⁻¹ A D, D = diag(d_i I₃), which has the
-   * eigenvalues of A = M^-1/2 K M^-1/2: max_i λ_i bounds the highest eigenvalue for
-   * every choice of positive weights. With all weights 1 these are the rows of
-   * particle_frequency_bounds(); bound_highest_frequency() takes the weights of
-   * gershgorin_row_weight().
+   * The squared block Gershgorin row bounds λ_i = diagonal[i] / m_i
+   * + Σ_e coupling[e] / sqrt(m_i m_j) from the system's Gershgorin @p terms (0 for
+   * constrained or massless particles): the rows of particle_frequency_bounds(), and
+   * the weights of the bound (gershgorin_row_weight()).
    */
   std::vector<double>
-  squared_frequency_bounds(const ParticleSystem      &system,
-                           const GershgorinTerms     &terms,
-                           const std::vector<double> &weights = {});
+  squared_frequency_bounds(const ParticleSystem &system, const GershgorinTerms &terms);
 
   /**
-   * The weight d_i of a row for squared_frequency_bounds(), from its bound with all
-   * weights 1, @p unscaled_row: that bound itself (1 if it is 0, for a particle
-   * without a row; a NaN stays NaN, so that the bound reports it). Where the rows
-   * differ, the heavy, slow particles next to a light, fast one then take a share of
-   * its coupling terms in proportion to how much lower their rows are: for a light
-   * particle on one spring to a heavy one, the scaled rows are the exact frequency.
+   * The squared rows λ_i of the bound of bound_highest_frequency() with the positive
+   * @p weights d (one per particle), from the system's Gershgorin @p terms (0 for
+   * constrained or massless particles):
+   *
+   * λ_i = λ_max( E_i + Σ_{e=(i,j)} (1 + t_e) P_e ) / m_i
+   *       + Σ_{e=(i,j), j free} e_e / sqrt(m_i m_j) · d_j / d_i,
+   * t_e = sqrt(m_i / m_j) d_j / d_i (0 if j is held),
+   *
+   * with P_e the springs' positive parts, E_i the force model's diagonal element
+   * blocks and e_e its off-diagonal norms (GershgorinTerms). A spring's share of the
+   * quadratic form, (x_i - x_j)ᵀ K_e (x_i - x_j), is at most
+   * (1 + t) x_iᵀ P_e x_i + (1 + 1/t) x_jᵀ P_e x_j for every t > 0, and an element's
+   * cross terms 2 x_iᵀ K_ij x_j at most ||K_ij|| (s x_i² + x_j² / s) for every s > 0;
+   * so xᵀ K x ≤ Σ_i λ_i m_i |x_i|², and max_i λ_i bounds the highest eigenvalue of
+   * M^-1/2 K M^-1/2 for every choice of positive weights (doc/stability.md).
+   */
+  std::vector<double>
+  weighted_frequency_bounds(const ParticleSystem      &system,
+                            const GershgorinTerms     &terms,
+                            const std::vector<double> &weights);
+
+  /**
+   * The weight d_i of a row for weighted_frequency_bounds(), from its block Gershgorin
+   * bound with all weights 1 (squared_frequency_bounds()), @p unscaled_row: that bound
+   * itself (1 if it is 0, for a particle without a row; a NaN stays NaN, so that the
+   * bound reports it). Where the rows differ, the heavy, slow particles next to a
+   * light, fast one then take a share of its coupling terms in proportion to how much
+   * lower their rows are: for a light particle on one spring to a heavy one, the
+   * weighted rows are the exact frequency.
    * A property of a row and its neighbours' rows only, so a local change of the
    * system changes the weights locally (StabilityBound::update()).
    */
@@ -109,13 +132,16 @@ namespace lacerta::physics
     std::vector<unsigned int>          tets, springs;
     std::vector<std::array<double, 6>> blocks;
     std::vector<double>                pair_norm, off_diagonal, stiffest;
-    /// The rows' diagonal terms λ_max(Σ_e K_e) / m_i and the springs' couplings
-    /// ||K_e|| / sqrt(m_i m_j).
-    std::vector<double> diagonal, coupling;
+    /// The diagonal terms λ_max(Σ_e K_e) / m_i of the rows weighted anew.
+    std::vector<double> diagonal;
+    /// GershgorinTerms::element_block of the rows, spring_block and
+    /// element_coupling (for held ends too) of the springs at the rows.
+    std::vector<std::array<double, 6>> element_blocks, spring_blocks;
+    std::vector<double>                element_norm;
   };
 
   /**
-   * The squared row bounds λ_i of squared_frequency_bounds() with @p weights (one per
+   * The squared row bounds λ_i of weighted_frequency_bounds() with @p weights (one per
    * particle) and the stiffest spring at the particles @p rows only (distinct), from
    * the springs and the force model's tetrahedra around them at positions @p x: into
    * @p lambda and @p stiffest_spring, one entry per row. The first @p n_reweighted
@@ -150,14 +176,13 @@ namespace lacerta::physics
                       double                          *row_sum);
 
   /**
-   * Bounds the highest eigenvalue of M^-1/2 K M^-1/2 by block Gershgorin over the free
-   * particles with scaled rows: λ ≤ max_i [λ_max(Σ_e K_e) / m_i
-   * + Σ_e ||K_e|| / sqrt(m_i m_j) · d_j / d_i], the weights d those of
-   * gershgorin_row_weight() (squared_frequency_bounds()), with the
-   * tangent stiffness of each spring at the current positions,
-   * K_e = k n nᵀ + k (1 - L0/L)(I - n nᵀ), whose geometric part matters for strongly
-   * compressed springs. A force model per tetrahedron adds its element stiffness
-   * blocks (gershgorin_terms()). Constrained particles do not move and drop out.
+   * Bounds the highest eigenvalue of M^-1/2 K M^-1/2 by the largest row of
+   * weighted_frequency_bounds() over the free particles, with the weights of
+   * gershgorin_row_weights(), the tangent stiffness of each spring at the current
+   * positions, K_e = k n nᵀ + k (1 - L0/L)(I - n nᵀ), whose geometric part matters for
+   * strongly compressed springs, and the element stiffness blocks of a force model
+   * per tetrahedron (gershgorin_terms()). Constrained particles do not move and drop
+   * out.
    */
   FrequencyBound
   bound_highest_frequency(const ParticleSystem &system);

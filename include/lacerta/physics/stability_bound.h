@@ -58,7 +58,7 @@ namespace lacerta::physics
       return lambda[i];
     }
 
-    /// The weight d_i of every particle's row (squared_frequency_bounds()).
+    /// The weight d_i of every particle's row (weighted_frequency_bounds()).
     const std::vector<double> &
     row_weights() const
     {
