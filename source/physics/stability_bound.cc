@@ -38,17 +38,17 @@ namespace lacerta::physics
     if (n > leaves)
       build_tree(n);
     row_mark.resize(n, 0);
-    // A particle's row with all weights 1, hence its weight, depends on its springs
-    // and tetrahedra and on its neighbours' masses: the changed and appended particles
-    // and every vertex of their stars get new weights. A weighted row reads its
-    // neighbours' weights: those particles and every vertex of their stars are bounded
-    // again, in one pass.
+    // The changed and appended particles get new weights (their rows with all weights
+    // 1); any positive weights give a bound, so the others keep theirs until the next
+    // compute(). A row depends on its springs and tetrahedra and on its neighbours'
+    // masses and weights: the changed particles and every vertex of their stars are
+    // bounded again.
     ++mark;
     rows.clear();
     for (const unsigned int p : changed)
-      add_star(system, p);
+      add_row(p);
     for (unsigned int p = before; p < n; ++p)
-      add_star(system, p);
+      add_row(p);
     const std::size_t n_reweighted = rows.size();
     for (std::size_t r = 0; r < n_reweighted; ++r)
       add_star(system, rows[r]);
@@ -68,16 +68,19 @@ namespace lacerta::physics
 
 
   void
+  StabilityBound::add_row(const unsigned int p)
+  {
+    if (row_mark[p] != mark)
+    {
+      row_mark[p] = mark;
+      rows.push_back(p);
+    }
+  }
+
+
+  void
   StabilityBound::add_star(const ParticleSystem &system, const unsigned int p)
   {
-    const auto add_row = [&](const unsigned int v)
-    {
-      if (row_mark[v] != mark)
-      {
-        row_mark[v] = mark;
-        rows.push_back(v);
-      }
-    };
     add_row(p);
     for (const unsigned int t : system.mesh->tets_of_vertex(p))
       for (const unsigned int v : system.mesh->tet(t))

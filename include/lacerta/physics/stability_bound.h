@@ -17,10 +17,10 @@ namespace lacerta::physics
   class ParticleSystem;
 
   /**
-   * The scaled block Gershgorin bound of bound_highest_frequency(), kept per particle
+   * The bound of bound_highest_frequency(), kept per particle
    * with the weights of its rows so that a local change of the system (a cut, a tear)
-   * costs a bound over the changed particles' stars and their neighbours' stars, not
-   * over the whole system: nothing global per cut.
+   * costs a bound over the changed particles' stars, not over the whole system:
+   * nothing global per cut.
    *
    * Between two compute(), a particle's bound is that of the positions it was last
    * computed at, as the bound of bound_highest_frequency() is that of the positions
@@ -35,10 +35,10 @@ namespace lacerta::physics
 
     /**
      * Updates the bound after a local change of the system: the particles listed in
-     * @p changed (ParticleSystem::changed_particles(), repeats allowed), the appended
-     * ones and their neighbours get new weights (gershgorin_row_weight()), and every
-     * row that reads one of them is bounded again at the current positions; the
-     * others keep their bound. Computes everything if the system has no mesh
+     * @p changed (ParticleSystem::changed_particles(), repeats allowed) and the
+     * appended ones get new weights (gershgorin_row_weight()), and they and their
+     * neighbours are bounded again at the current positions; the others keep their
+     * bound and weight. Computes everything if the system has no mesh
      * with local updates whose edges are its springs, if every particle counts as
      * changed
      * (ParticleSystem::all_particles_changed()), or if compute() was never called.
@@ -75,8 +75,12 @@ namespace lacerta::physics
     void
     build_tree(unsigned int n);
 
+    /// Appends particle @p p to `rows` unless it holds it (marked with `mark`).
+    void
+    add_row(unsigned int p);
+
     /// Appends to `rows` particle @p p and the vertices of its star that it does not
-    /// hold yet (those marked with `mark`).
+    /// hold yet.
     void
     add_star(const ParticleSystem &system, unsigned int p);
 
