@@ -145,6 +145,14 @@ namespace lacerta::physics
     }
 
 
+    /// Whether particle @p i has a row in the bound: free, with a mass.
+    bool
+    has_row(const ParticleSystem &system, const unsigned int i)
+    {
+      return system.free[i] > 0 && system.mass[i] > 0;
+    }
+
+
     /// The factor the force model applies to the springs (1 without a model).
     double
     spring_scale(const ParticleSystem &system)
@@ -362,16 +370,15 @@ namespace lacerta::physics
     const SpringSet      &springs = system.springs;
     GershgorinRowScratch &w       = scratch;
     gather_row_terms(system, x, rows, w);
-    const auto is_row  = [&](const unsigned int p) { return w.row_stamp[p] == w.stamp; };
-    const auto has_row = [&](const unsigned int i)
-    { return system.free[i] > 0 && system.mass[i] > 0; };
+    const auto is_row = [&](const unsigned int p) { return w.row_stamp[p] == w.stamp; };
     // The weights of the first rows: their block Gershgorin rows, as
     // squared_frequency_bounds() makes them from gershgorin_terms().
     w.diagonal.resize(n_reweighted);
     w.off_diagonal.assign(rows.size(), 0.0);
     for (std::size_t r = 0; r < n_reweighted; ++r)
-      w.diagonal[r] =
-        has_row(rows[r]) ? largest_eigenvalue(w.blocks[r]) / system.mass[rows[r]] : 0.0;
+      w.diagonal[r] = has_row(system, rows[r])
+                        ? largest_eigenvalue(w.blocks[r]) / system.mass[rows[r]]
+                        : 0.0;
     for (std::size_t k = 0; k < w.springs.size() && n_reweighted > 0; ++k)
     {
       const unsigned int s = w.springs[k], i = springs.a[s], j = springs.b[s];
@@ -384,8 +391,8 @@ namespace lacerta::physics
     }
     for (std::size_t r = 0; r < n_reweighted; ++r)
     {
-      weights[rows[r]] =
-        gershgorin_row_weight(has_row(rows[r]) ? w.diagonal[r] + w.off_diagonal[r] : 0.0);
+      weights[rows[r]] = gershgorin_row_weight(
+        has_row(system, rows[r]) ? w.diagonal[r] + w.off_diagonal[r] : 0.0);
       w.off_diagonal[r] = 0;
     }
     // The weighted rows, as weighted_frequency_bounds() makes them: the element
@@ -416,7 +423,7 @@ namespace lacerta::physics
         }
     }
     for (std::size_t r = 0; r < rows.size(); ++r)
-      lambda[r] = has_row(rows[r])
+      lambda[r] = has_row(system, rows[r])
                     ? largest_eigenvalue(w.element_blocks[r]) / system.mass[rows[r]]
                         + w.off_diagonal[r]
                     : 0.0;
@@ -462,7 +469,7 @@ namespace lacerta::physics
       }
     std::vector<double> lambda(n, 0.0);
     for (unsigned int i = 0; i < n; ++i)
-      if (system.free[i] > 0 && system.mass[i] > 0)
+      if (has_row(system, i))
         lambda[i] = terms.diagonal[i] / system.mass[i] + off_diagonal[i];
     return lambda;
   }
@@ -491,7 +498,7 @@ namespace lacerta::physics
     }
     std::vector<double> lambda(n, 0.0);
     for (unsigned int i = 0; i < n; ++i)
-      if (system.free[i] > 0 && system.mass[i] > 0)
+      if (has_row(system, i))
         lambda[i] = largest_eigenvalue(blocks[i]) / system.mass[i] + off_diagonal[i];
     return lambda;
   }
