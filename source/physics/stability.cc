@@ -72,8 +72,8 @@ namespace lacerta::physics
      * The tangent stiffness K_e = (k - g) n nᵀ + g I of spring @p s at positions @p x
      * (k its stiffness times @p scale, g = k (1 - L0/L) the geometric stiffness) as a
      * symmetric block, in @p norm the bound max(k, |g|) of ||K_e||, and in
-     * @p positive the block P_e = (k - g⁺) n nᵀ + g⁺ I, g⁺ = max(g, 0), with
-     * K_e ≤ P_e and P_e positive semi-definite.
+     * @p absolute the block |K_e| = (k - |g|) n nᵀ + |g| I, positive semi-definite
+     * with -|K_e| ≤ K_e ≤ |K_e|.
      */
     std::array<double, 6>
     spring_tangent_block(const SpringSet       &springs,
@@ -81,7 +81,7 @@ namespace lacerta::physics
                          const double          *x,
                          const double           scale,
                          double                &norm,
-                         std::array<double, 6> &positive)
+                         std::array<double, 6> &absolute)
     {
       const unsigned int i = springs.a[s], j = springs.b[s];
       double             d[3]   = {x[3 * j] - x[3 * i],
@@ -93,8 +93,8 @@ namespace lacerta::physics
       const double k         = scale * springs.stiffness[s];
       const double geometric = k * (1.0 - springs.rest_length[s] / length);
       norm                   = std::max(k, std::abs(geometric));
-      const double g         = std::max(geometric, 0.0);
-      positive               = {(k - g) * d[0] * d[0] + g,
+      const double g         = std::abs(geometric);
+      absolute               = {(k - g) * d[0] * d[0] + g,
                                 (k - g) * d[1] * d[1] + g,
                                 (k - g) * d[2] * d[2] + g,
                                 (k - g) * d[0] * d[1],
@@ -163,8 +163,28 @@ namespace lacerta::physics
 
 
     /**
+     * The bound of a row's diagonal terms for weighted_frequency_bounds(): the larger
+     * of λ_max(S + E) and λ_max(S - E) for the springs' sum @p springs S = Σ (1 + t_e)
+     * |K_e| and the force model's diagonal element block @p element E; the first
+     * bounds the row's share of xᵀ K x, the second that of -xᵀ K x.
+     */
+    double
+    row_block_bound(const std::array<double, 6> &springs,
+                    const std::array<double, 6> &element)
+    {
+      std::array<double, 6> plus, minus;
+      for (unsigned int c = 0; c < 6; ++c)
+      {
+        plus[c]  = springs[c] + element[c];
+        minus[c] = springs[c] - element[c];
+      }
+      return std::max(largest_eigenvalue(plus), largest_eigenvalue(minus));
+    }
+
+
+    /**
      * Adds the terms of the spring between row @p p and particle @p q to row p of the
-     * weighted bound (weighted_frequency_bounds()): (1 + t) P_e to the row's @p block,
+     * weighted bound (weighted_frequency_bounds()): (1 + t) |K_e| to the row's @p block,
      * t = sqrt(m_p / m_q) d_q / d_p if both ends are free (0 if q is held), and the
      * norm @p element_norm of the force model's off-diagonal block on the edge, over
      * sqrt(m_p m_q) times d_q / d_p, to @p off_diagonal.
@@ -174,7 +194,7 @@ namespace lacerta::physics
                               const unsigned int           p,
                               const unsigned int           q,
                               const std::vector<double>   &weights,
-                              const std::array<double, 6> &positive,
+                              const std::array<double, 6> &absolute,
                               const double                 element_norm,
                               std::array<double, 6>       &block,
                               double                      &off_diagonal)
@@ -183,7 +203,7 @@ namespace lacerta::physics
       const double ratio   = coupled ? weights[q] / weights[p] : 0.0;
       const double t = coupled ? std::sqrt(system.mass[p] / system.mass[q]) * ratio : 0.0;
       for (unsigned int c = 0; c < 6; ++c)
-        block[c] += (1 + t) * positive[c];
+        block[c] += (1 + t) * absolute[c];
       if (coupled && element_norm > 0)
         off_diagonal += element_norm / std::sqrt(system.mass[p] * system.mass[q]) * ratio;
     }
@@ -354,6 +374,58 @@ namespace lacerta::physics
               });
           });
     }
+
+
+    /**
+     * The rows λ_i of weighted_frequency_bounds() with @p weights for the first @p n
+     * of the rows @p rows gathered in @p w (gather_row_terms()), into @p lambda; the
+     * stiffest spring at each into @p stiffest_spring unless it is nullptr. Reads the
+     * weights of the rows' neighbours.
+     */
+    void
+    weighted_rows(const ParticleSystem            &system,
+                  const std::vector<unsigned int> &rows,
+                  const std::size_t                n,
+                  const std::vector<double>       &weights,
+                  GershgorinRowScratch            &w,
+                  double                          *lambda,
+                  unsigned int                    *stiffest_spring)
+    {
+      const SpringSet &springs = system.springs;
+      w.row_blocks.assign(n, std::array<double, 6>{});
+      w.off_diagonal.assign(n, 0.0);
+      w.stiffest.assign(n, 0.0);
+      for (std::size_t r = 0; r < n && stiffest_spring != nullptr; ++r)
+        stiffest_spring[r] = 0;
+      for (std::size_t k = 0; k < w.springs.size(); ++k)
+      {
+        const unsigned int s = w.springs[k], i = springs.a[s], j = springs.b[s];
+        for (const auto &[p, q] : {std::pair{i, j}, std::pair{j, i}})
+          if (w.row_stamp[p] == w.stamp && w.row_of[p] < n)
+          {
+            const unsigned int r = w.row_of[p];
+            add_weighted_spring_terms(system,
+                                      p,
+                                      q,
+                                      weights,
+                                      w.spring_blocks[k],
+                                      w.element_norm[k],
+                                      w.row_blocks[r],
+                                      w.off_diagonal[r]);
+            if (stiffest_spring != nullptr && w.pair_norm[k] > w.stiffest[r])
+            {
+              w.stiffest[r]      = w.pair_norm[k];
+              stiffest_spring[r] = s;
+            }
+          }
+      }
+      for (std::size_t r = 0; r < n; ++r)
+        lambda[r] =
+          has_row(system, rows[r])
+            ? row_block_bound(w.row_blocks[r], w.element_blocks[r]) / system.mass[rows[r]]
+                + w.off_diagonal[r]
+            : 0.0;
+    }
   } // namespace
 
 
@@ -362,6 +434,7 @@ namespace lacerta::physics
                   const double                    *x,
                   const std::vector<unsigned int> &rows,
                   const std::size_t                n_reweighted,
+                  std::vector<double>             &first_weights,
                   std::vector<double>             &weights,
                   GershgorinRowScratch            &scratch,
                   double                          *lambda,
@@ -371,10 +444,10 @@ namespace lacerta::physics
     GershgorinRowScratch &w       = scratch;
     gather_row_terms(system, x, rows, w);
     const auto is_row = [&](const unsigned int p) { return w.row_stamp[p] == w.stamp; };
-    // The weights of the first rows: their block Gershgorin rows, as
+    // The first weights of the first rows: their block Gershgorin rows, as
     // squared_frequency_bounds() makes them from gershgorin_terms().
     w.diagonal.resize(n_reweighted);
-    w.off_diagonal.assign(rows.size(), 0.0);
+    w.off_diagonal.assign(n_reweighted, 0.0);
     for (std::size_t r = 0; r < n_reweighted; ++r)
       w.diagonal[r] = has_row(system, rows[r])
                         ? largest_eigenvalue(w.blocks[r]) / system.mass[rows[r]]
@@ -390,43 +463,17 @@ namespace lacerta::physics
           w.off_diagonal[w.row_of[p]] += c;
     }
     for (std::size_t r = 0; r < n_reweighted; ++r)
-    {
-      weights[rows[r]] = gershgorin_row_weight(
+      first_weights[rows[r]] = gershgorin_row_weight(
         has_row(system, rows[r]) ? w.diagonal[r] + w.off_diagonal[r] : 0.0);
-      w.off_diagonal[r] = 0;
-    }
+    // Their weights, one step on (refined_row_weights()).
+    w.refined.resize(n_reweighted);
+    weighted_rows(
+      system, rows, n_reweighted, first_weights, w, w.refined.data(), nullptr);
+    for (std::size_t r = 0; r < n_reweighted; ++r)
+      weights[rows[r]] = refined_row_weight(w.refined[r], first_weights[rows[r]]);
     // The weighted rows, as weighted_frequency_bounds() makes them: the element
-    // blocks, the springs' positive parts and the element couplings.
-    w.stiffest.assign(rows.size(), 0.0);
-    for (std::size_t r = 0; r < rows.size(); ++r)
-      stiffest_spring[r] = 0;
-    for (std::size_t k = 0; k < w.springs.size(); ++k)
-    {
-      const unsigned int s = w.springs[k], i = springs.a[s], j = springs.b[s];
-      for (const auto [p, q] : {std::pair{i, j}, std::pair{j, i}})
-        if (is_row(p))
-        {
-          const unsigned int r = w.row_of[p];
-          add_weighted_spring_terms(system,
-                                    p,
-                                    q,
-                                    weights,
-                                    w.spring_blocks[k],
-                                    w.element_norm[k],
-                                    w.element_blocks[r],
-                                    w.off_diagonal[r]);
-          if (w.pair_norm[k] > w.stiffest[r])
-          {
-            w.stiffest[r]      = w.pair_norm[k];
-            stiffest_spring[r] = s;
-          }
-        }
-    }
-    for (std::size_t r = 0; r < rows.size(); ++r)
-      lambda[r] = has_row(system, rows[r])
-                    ? largest_eigenvalue(w.element_blocks[r]) / system.mass[rows[r]]
-                        + w.off_diagonal[r]
-                    : 0.0;
+    // blocks, the springs' absolute values and the element couplings.
+    weighted_rows(system, rows, rows.size(), weights, w, lambda, stiffest_spring);
   }
 
 
@@ -480,13 +527,13 @@ namespace lacerta::physics
                             const GershgorinTerms     &terms,
                             const std::vector<double> &weights)
   {
-    const unsigned int                 n      = system.n_particles();
-    std::vector<std::array<double, 6>> blocks = terms.element_block;
+    const unsigned int                 n = system.n_particles();
+    std::vector<std::array<double, 6>> blocks(n, std::array<double, 6>{});
     std::vector<double>                off_diagonal(n, 0.0);
     for (std::size_t s = 0; s < system.springs.size(); ++s)
     {
       const unsigned int i = system.springs.a[s], j = system.springs.b[s];
-      for (const auto [p, q] : {std::pair{i, j}, std::pair{j, i}})
+      for (const auto &[p, q] : {std::pair{i, j}, std::pair{j, i}})
         add_weighted_spring_terms(system,
                                   p,
                                   q,
@@ -499,7 +546,8 @@ namespace lacerta::physics
     std::vector<double> lambda(n, 0.0);
     for (unsigned int i = 0; i < n; ++i)
       if (has_row(system, i))
-        lambda[i] = largest_eigenvalue(blocks[i]) / system.mass[i] + off_diagonal[i];
+        lambda[i] = row_block_bound(blocks[i], terms.element_block[i]) / system.mass[i]
+                    + off_diagonal[i];
     return lambda;
   }
 
@@ -511,6 +559,18 @@ namespace lacerta::physics
     for (double &w : weights)
       w = gershgorin_row_weight(w);
     return weights;
+  }
+
+
+  std::vector<double>
+  refined_row_weights(const ParticleSystem      &system,
+                      const GershgorinTerms     &terms,
+                      const std::vector<double> &weights)
+  {
+    std::vector<double> refined = weighted_frequency_bounds(system, terms, weights);
+    for (unsigned int i = 0; i < refined.size(); ++i)
+      refined[i] = refined_row_weight(refined[i], weights[i]);
+    return refined;
   }
 
 
@@ -528,9 +588,11 @@ namespace lacerta::physics
   FrequencyBound
   bound_highest_frequency(const ParticleSystem &system)
   {
-    const GershgorinTerms     terms = gershgorin_terms(system, system.position.data());
-    const std::vector<double> lambda =
-      weighted_frequency_bounds(system, terms, gershgorin_row_weights(system, terms));
+    const GershgorinTerms     terms  = gershgorin_terms(system, system.position.data());
+    const std::vector<double> lambda = weighted_frequency_bounds(
+      system,
+      terms,
+      refined_row_weights(system, terms, gershgorin_row_weights(system, terms)));
     FrequencyBound bound;
     double         largest = 0;
     for (unsigned int i = 0; i < lambda.size(); ++i)

@@ -11,7 +11,8 @@ namespace lacerta::physics
   StabilityBound::compute(const ParticleSystem &system)
   {
     const GershgorinTerms terms = gershgorin_terms(system, system.position.data());
-    weights                     = gershgorin_row_weights(system, terms);
+    first_weights               = gershgorin_row_weights(system, terms);
+    weights                     = refined_row_weights(system, terms, first_weights);
     lambda                      = weighted_frequency_bounds(system, terms, weights);
     stiffest                    = terms.stiffest_spring;
     build_tree(system.n_particles());
@@ -34,15 +35,16 @@ namespace lacerta::physics
     const unsigned int before = static_cast<unsigned int>(lambda.size());
     lambda.resize(n, 0.0);
     stiffest.resize(n, 0);
+    first_weights.resize(n, 1.0);
     weights.resize(n, 1.0);
     if (n > leaves)
       build_tree(n);
     row_mark.resize(n, 0);
     // The changed and appended particles get new weights (their rows with all weights
-    // 1); any positive weights give a bound, so the others keep theirs until the next
-    // compute(). A row depends on its springs and tetrahedra and on its neighbours'
-    // masses and weights: the changed particles and every vertex of their stars are
-    // bounded again.
+    // 1, then their rows with those); any positive weights give a bound, so the others
+    // keep theirs until the next compute(). A row depends on its springs and tetrahedra
+    // and on its neighbours' masses and weights: the changed particles and every vertex
+    // of their stars are bounded again.
     ++mark;
     rows.clear();
     for (const unsigned int p : changed)
@@ -58,6 +60,7 @@ namespace lacerta::physics
                     system.position.data(),
                     rows,
                     n_reweighted,
+                    first_weights,
                     weights,
                     scratch,
                     row_lambda.data(),
@@ -149,6 +152,6 @@ namespace lacerta::physics
   StabilityBound::serialize(Archive &archive)
   {
     archive.section("stability bound");
-    archive(lambda, stiffest, weights, tree, leaves);
+    archive(lambda, stiffest, first_weights, weights, tree, leaves);
   }
 } // namespace lacerta::physics

@@ -44,7 +44,7 @@ namespace lacerta::physics
     std::vector<double> coupling;
     /// The stiffest spring at each particle.
     std::vector<unsigned int> stiffest_spring;
-    /// The positive part P_e = k n nᵀ + max(g, 0) (I - n nᵀ) of each spring's tangent
+    /// The absolute value |K_e| = k n nᵀ + |g| (I - n nᵀ) of each spring's tangent
     /// stiffness (g its geometric stiffness), xx, yy, zz, xy, xz, yz.
     std::vector<std::array<double, 6>> spring_block;
     /// The sum of the force model's diagonal element blocks at each particle.
@@ -80,17 +80,21 @@ namespace lacerta::physics
    * @p weights d (one per particle), from the system's Gershgorin @p terms (0 for
    * constrained or massless particles):
    *
-   * λ_i = λ_max( E_i + Σ_{e=(i,j)} (1 + t_e) P_e ) / m_i
+   * λ_i = max(λ_max(S_i + E_i), λ_max(S_i - E_i)) / m_i
    *       + Σ_{e=(i,j), j free} e_e / sqrt(m_i m_j) · d_j / d_i,
-   * t_e = sqrt(m_i / m_j) d_j / d_i (0 if j is held),
+   * S_i = Σ_{e=(i,j)} (1 + t_e) |K_e|,   t_e = sqrt(m_i / m_j) d_j / d_i (0 if j is
+   * held),
    *
-   * with P_e the springs' positive parts, E_i the force model's diagonal element
-   * blocks and e_e its off-diagonal norms (GershgorinTerms). A spring's share of the
-   * quadratic form, (x_i - x_j)ᵀ K_e (x_i - x_j), is at most
-   * (1 + t) x_iᵀ P_e x_i + (1 + 1/t) x_jᵀ P_e x_j for every t > 0, and an element's
-   * cross terms 2 x_iᵀ K_ij x_j at most ||K_ij|| (s x_i² + x_j² / s) for every s > 0;
-   * so xᵀ K x ≤ Σ_i λ_i m_i |x_i|², and max_i λ_i bounds the highest eigenvalue of
-   * M^-1/2 K M^-1/2 for every choice of positive weights (doc/stability.md).
+   * with |K_e| the springs' absolute tangent blocks, E_i the force model's diagonal
+   * element blocks and e_e its off-diagonal norms (GershgorinTerms). A spring's share
+   * of the quadratic form, ±(x_i - x_j)ᵀ K_e (x_i - x_j), is at most
+   * (1 + t) x_iᵀ |K_e| x_i + (1 + 1/t) x_jᵀ |K_e| x_j for every t > 0, and an element's
+   * cross terms ±2 x_iᵀ K_ij x_j at most ||K_ij|| (s x_i² + x_j² / s) for every s > 0;
+   * so |xᵀ K x| ≤ Σ_i λ_i m_i |x_i|², and max_i λ_i bounds the largest eigenvalue of
+   * M^-1/2 K M^-1/2 in magnitude for every choice of positive weights
+   * (doc/stability.md): the highest frequency, and the fastest growth or decay of a
+   * strongly compressed spring's negative stiffness, which the explicit schemes must
+   * resolve as well.
    */
   std::vector<double>
   weighted_frequency_bounds(const ParticleSystem      &system,
@@ -119,6 +123,30 @@ namespace lacerta::physics
   gershgorin_row_weights(const ParticleSystem &system, const GershgorinTerms &terms);
 
   /**
+   * The weight of a row one power step on from weight @p weight, at which the row of
+   * weighted_frequency_bounds() is @p weighted_row: their product (1 for a particle
+   * without a row; a NaN stays NaN). With d the first weights (gershgorin_row_weight(),
+   * the rows of |A| times the vector of ones, for A = M^-1/2 K M^-1/2), this is about
+   * |A| d: the next step of the power iteration towards the eigenvector of the highest
+   * frequency, whose weights make the bound exact. Like the first weights, a property
+   * of a row and its neighbours' (first) weights, so local.
+   */
+  inline double
+  refined_row_weight(const double weighted_row, const double weight)
+  {
+    return gershgorin_row_weight(weighted_row * weight);
+  }
+
+  /// refined_row_weight() of every particle from the rows of
+  /// weighted_frequency_bounds() with @p weights, from the system's Gershgorin
+  /// @p terms: the weights of bound_highest_frequency() from those of
+  /// gershgorin_row_weights().
+  std::vector<double>
+  refined_row_weights(const ParticleSystem      &system,
+                      const GershgorinTerms     &terms,
+                      const std::vector<double> &weights);
+
+  /**
    * Working space of gershgorin_rows() and gershgorin_row_sums(), kept between calls so
    * that a local update allocates nothing once it has grown: marks per particle, spring
    * and tetrahedron, and the terms of the rows being computed.
@@ -138,6 +166,10 @@ namespace lacerta::physics
     /// element_coupling (for held ends too) of the springs at the rows.
     std::vector<std::array<double, 6>> element_blocks, spring_blocks;
     std::vector<double>                element_norm;
+    /// The blocks of the weighted rows being summed, and the weighted rows of the
+    /// rows weighted anew with their first weights.
+    std::vector<std::array<double, 6>> row_blocks;
+    std::vector<double>                refined;
   };
 
   /**
@@ -145,8 +177,10 @@ namespace lacerta::physics
    * particle) and the stiffest spring at the particles @p rows only (distinct), from
    * the springs and the force model's tetrahedra around them at positions @p x: into
    * @p lambda and @p stiffest_spring, one entry per row. The first @p n_reweighted
-   * rows get their weights anew first (gershgorin_row_weight() of their rows with all
-   * weights 1), so @p rows must hold every neighbour of those, whose rows read them.
+   * rows get their weights anew first: their first weights (gershgorin_row_weight() of
+   * their rows with all weights 1) into @p first_weights, then their weights
+   * (refined_row_weight() of their rows with the first weights) into @p weights; so
+   * @p rows must hold every neighbour of those, whose rows read them.
    * The same values as the computation over the whole system with those weights, to
    * rounding, at a cost that depends on the rows' stars only. Needs `system.mesh`
    * with local updates (its edges are the springs).
@@ -156,6 +190,7 @@ namespace lacerta::physics
                   const double                    *x,
                   const std::vector<unsigned int> &rows,
                   std::size_t                      n_reweighted,
+                  std::vector<double>             &first_weights,
                   std::vector<double>             &weights,
                   GershgorinRowScratch            &scratch,
                   double                          *lambda,
@@ -178,11 +213,11 @@ namespace lacerta::physics
   /**
    * Bounds the highest eigenvalue of M^-1/2 K M^-1/2 by the largest row of
    * weighted_frequency_bounds() over the free particles, with the weights of
-   * gershgorin_row_weights(), the tangent stiffness of each spring at the current
-   * positions, K_e = k n nᵀ + k (1 - L0/L)(I - n nᵀ), whose geometric part matters for
-   * strongly compressed springs, and the element stiffness blocks of a force model
-   * per tetrahedron (gershgorin_terms()). Constrained particles do not move and drop
-   * out.
+   * refined_row_weights() from those of gershgorin_row_weights(), the tangent stiffness
+   * of each spring at the current positions, K_e = k n nᵀ + k (1 - L0/L)(I - n nᵀ), whose
+   * geometric part matters for strongly compressed springs, and the element stiffness
+   * blocks of a force model per tetrahedron (gershgorin_terms()). Constrained particles
+   * do not move and drop out.
    */
   FrequencyBound
   bound_highest_frequency(const ParticleSystem &system);

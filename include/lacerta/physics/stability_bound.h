@@ -36,7 +36,8 @@ namespace lacerta::physics
     /**
      * Updates the bound after a local change of the system: the particles listed in
      * @p changed (ParticleSystem::changed_particles(), repeats allowed) and the
-     * appended ones get new weights (gershgorin_row_weight()), and they and their
+     * appended ones get new weights (gershgorin_row_weight(), refined_row_weight()),
+     * and they and their
      * neighbours are bounded again at the current positions; the others keep their
      * bound and weight. Computes everything if the system has no mesh
      * with local updates whose edges are its springs, if every particle counts as
@@ -95,9 +96,10 @@ namespace lacerta::physics
     /// λ_i = ω_i² and the stiffest spring of every particle.
     std::vector<double>       lambda;
     std::vector<unsigned int> stiffest;
-    /// The weight of every particle's row: gershgorin_row_weight() of its row with
-    /// all weights 1.
-    std::vector<double> weights;
+    /// The first weight of every particle's row, gershgorin_row_weight() of its row
+    /// with all weights 1, and its weight, refined_row_weight() of its row with the
+    /// first weights.
+    std::vector<double> first_weights, weights;
     /// A tree of maxima: node k holds the best particle of its two children, the
     /// leaves (from `leaves` on) the particles; `none` past the last particle.
     std::vector<unsigned int>     tree;
