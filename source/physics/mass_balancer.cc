@@ -6,6 +6,7 @@
 #include <lacerta/physics/stability.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -280,6 +281,9 @@ namespace lacerta::physics
     gifts_of.resize(n);
     before_of.resize(n, 0.0);
     momentum_of.resize(3 * std::size_t(n), 0.0);
+    mass_in.resize(n, 0.0);
+    mass_out.resize(n, 0.0);
+    outgoing.resize(3 * std::size_t(n), 0.0);
     touched.clear();
     const auto touch = [&](const unsigned int p)
     {
@@ -381,27 +385,93 @@ namespace lacerta::physics
     }
     for (const unsigned int p : touched)
       pending[p] = 0;
-    // Mass and momentum, from the state before: each gift goes back to its donor with
-    // its taker's velocity. What leaves a particle has its velocity, so only what
-    // arrives changes it: v += Σ m (v_from - v) / m_new, with no difference of large
-    // momenta that rounding would leave behind at a particle left light.
+    // Mass and momentum: each gift goes back to its donor with the velocity u of its
+    // taker, and every particle's new velocity is the mass-weighted mean of what it
+    // keeps and what it receives, so momentum is kept and kinetic energy cannot grow
+    // (every step is a merge of parcels of mass). A particle keeps what it had less
+    // what leaves it at its velocity, u = v. One that returns more than it has (a cut
+    // took the cells of a donor that was also a taker) first receives, then returns
+    // at the velocity it then has, u = (m v + Σ m_g u_g) / (m + Σ m_g) over the gifts
+    // coming back to it; those velocities can depend on each other along chains of
+    // gifts, so they are iterated. Returning at the velocity before receiving would
+    // divide the momentum of what comes back by the small mass left, and create
+    // kinetic energy. A mass made negative by a cut counts as 0 in the means.
     for (const unsigned int p : touched)
+    {
+      mass_in[p]  = 0;
+      mass_out[p] = 0;
       for (unsigned int c = 0; c < 3; ++c)
-        momentum_of[3 * p + c] = 0;
+        outgoing[3 * p + c] = system.velocity[3 * p + c];
+    }
     for (const unsigned int g : taken_back)
     {
-      const Gift  &gift = gifts[g];
-      const double m    = returned[g];
-      system.mass[gift.taker] -= m;
-      system.mass[gift.donor] += m;
-      for (unsigned int c = 0; c < 3; ++c)
-        momentum_of[3 * gift.donor + c] +=
-          m * (system.velocity[3 * gift.taker + c] - system.velocity[3 * gift.donor + c]);
+      mass_out[gifts[g].taker] += returned[g];
+      mass_in[gifts[g].donor] += returned[g];
     }
-    for (const unsigned int p : touched)
-      if (system.mass[p] > 0)
+    const auto receive = [&]
+    {
+      for (const unsigned int p : touched)
         for (unsigned int c = 0; c < 3; ++c)
-          system.velocity[3 * p + c] += momentum_of[3 * p + c] / system.mass[p];
+          momentum_of[3 * p + c] = 0;
+      for (const unsigned int g : taken_back)
+        for (unsigned int c = 0; c < 3; ++c)
+          momentum_of[3 * gifts[g].donor + c] +=
+            returned[g] * outgoing[3 * gifts[g].taker + c];
+    };
+    const auto returns_more_than_it_has = [&](const unsigned int p)
+    { return system.mass[p] < mass_out[p] && mass_in[p] > 0; };
+    // Their velocities by Gauss-Seidel sweeps over the gifts coming back to them
+    // (diagonally dominant: each one's mass and what it receives).
+    deficit_gifts.clear();
+    for (const unsigned int g : taken_back)
+      if (returns_more_than_it_has(gifts[g].donor))
+        deficit_gifts.push_back(g);
+    std::sort(deficit_gifts.begin(),
+              deficit_gifts.end(),
+              [&](const unsigned int a, const unsigned int b)
+              { return gifts[a].donor < gifts[b].donor; });
+    for (unsigned int sweep = 0; sweep < max_velocity_sweeps && !deficit_gifts.empty();
+         ++sweep)
+    {
+      double change = 0, scale = 0;
+      for (std::size_t k = 0; k < deficit_gifts.size();)
+      {
+        const unsigned int    p   = gifts[deficit_gifts[k]].donor;
+        const double          own = std::max(system.mass[p], 0.0);
+        std::array<double, 3> u{};
+        for (unsigned int c = 0; c < 3; ++c)
+          u[c] = own * system.velocity[3 * p + c];
+        for (; k < deficit_gifts.size() && gifts[deficit_gifts[k]].donor == p; ++k)
+        {
+          const unsigned int g = deficit_gifts[k];
+          for (unsigned int c = 0; c < 3; ++c)
+            u[c] += returned[g] * outgoing[3 * gifts[g].taker + c];
+        }
+        for (unsigned int c = 0; c < 3; ++c)
+        {
+          u[c] /= own + mass_in[p];
+          change              = std::max(change, std::abs(u[c] - outgoing[3 * p + c]));
+          scale               = std::max(scale, std::abs(u[c]));
+          outgoing[3 * p + c] = u[c];
+        }
+      }
+      if (change <= 1e-15 * scale)
+        break;
+    }
+    receive();
+    for (const unsigned int p : touched)
+    {
+      const double kept = std::max(system.mass[p] - mass_out[p], 0.0);
+      if (returns_more_than_it_has(p))
+        for (unsigned int c = 0; c < 3; ++c)
+          system.velocity[3 * p + c] = outgoing[3 * p + c];
+      else if (mass_in[p] > 0)
+        for (unsigned int c = 0; c < 3; ++c)
+          system.velocity[3 * p + c] =
+            (kept * system.velocity[3 * p + c] + momentum_of[3 * p + c])
+            / (kept + mass_in[p]);
+      system.mass[p] += mass_in[p] - mass_out[p];
+    }
     compact_gifts();
     for (const unsigned int p : region)
       in_region[p] = 0;

@@ -49,6 +49,23 @@ namespace
     }
     return nearest;
   }
+
+
+  /// Moves most of the mass of the particle nearest the box's centre to a neighbour,
+  /// as when a cut leaves it with small cells only; returns that particle.
+  unsigned int
+  make_interior_particle_light(const mesh::TetMesh &mesh, physics::ParticleSystem &system)
+  {
+    const unsigned int i = interior_particle(mesh);
+    unsigned int       j = i;
+    for (std::size_t s = 0; s < system.springs.size() && j == i; ++s)
+      if (system.springs.a[s] == i)
+        j = system.springs.b[s];
+    EXPECT_NE(i, j);
+    system.mass[j] += 0.999 * system.mass[i];
+    system.mass[i] *= 0.001;
+    return i;
+  }
 } // namespace
 
 
@@ -73,17 +90,10 @@ TEST(PhysicsMassBalancer, ALightParticleIsRaisedToTheTargetFromItsNeighbours)
   mesh.enable_local_updates();
   auto                  system = test_support::make_system(mesh, 1000, 1e4);
   physics::MassBalancer balancer(*system, 3);
-  // Most of one particle's mass goes to a neighbour, as when a cut leaves it with
-  // small cells only: its bound rises far above the target.
-  const unsigned int i = interior_particle(mesh);
-  unsigned int       j = i;
-  for (std::size_t s = 0; s < system->springs.size() && j == i; ++s)
-    if (system->springs.a[s] == i)
-      j = system->springs.b[s];
-  ASSERT_NE(i, j);
+  // Most of one particle's mass goes to a neighbour: its bound rises far above the
+  // target.
   const double total = total_mass(*system);
-  system->mass[j] += 0.999 * system->mass[i];
-  system->mass[i] *= 0.001;
+  make_interior_particle_light(mesh, *system);
   ASSERT_GT(rest_bound(*system), 10 * balancer.target());
 
   const physics::MassBalanceStatistics s = balancer.balance(*system);
@@ -145,4 +155,61 @@ TEST(PhysicsMassBalancer, ATinyPieceOnItsOwnKeepsItsMassAndIsReported)
   EXPECT_EQ(s.unresolved, 4u);
   EXPECT_EQ(s.moved, 0);
   EXPECT_EQ(piece->mass, std::vector<double>(4, 1e-9));
+}
+
+
+TEST(PhysicsMassBalancer,
+     TakingBackTheGiftsOfADonorThatLostItsCellsCreatesNoKineticEnergy)
+{
+  mesh::TetMesh mesh = test_support::distorted_box(4, 0.2, {1, 1, 1});
+  mesh.enable_local_updates();
+  auto system = test_support::make_system(mesh, 1000, 1e4);
+  // Mass from the nearest ring only.
+  physics::MassBalancer balancer(*system, 1);
+  // As above: one particle left light and raised from its neighbours; it alone moves.
+  const unsigned int        i      = make_interior_particle_light(mesh, *system);
+  const std::vector<double> lumped = system->mass;
+  balancer.balance(*system);
+  // The donor that gave most.
+  unsigned int d     = i;
+  double       given = 0;
+  for (unsigned int p = 0; p < system->n_particles(); ++p)
+    if (lumped[p] - system->mass[p] > given)
+    {
+      given = lumped[p] - system->mass[p];
+      d     = p;
+    }
+  ASSERT_GT(given, 0);
+  std::fill(system->velocity.begin(), system->velocity.end(), 0.0);
+  system->velocity[3 * i] = 1;
+  const auto kinetic      = [&]
+  {
+    double e = 0;
+    for (unsigned int p = 0; p < system->n_particles(); ++p)
+      e +=
+        0.5 * system->mass[p]
+        * (std::pow(system->velocity[3 * p], 2) + std::pow(system->velocity[3 * p + 1], 2)
+           + std::pow(system->velocity[3 * p + 2], 2));
+    return e;
+  };
+  const double before = kinetic();
+  // A cut takes most of the donor's cells (to a copy, at rest): its own mass falls to a
+  // tenth of what it gave, so it holds less than nothing until its gifts come back. Its
+  // other neighbours are held, so that nothing can raise it again afterwards (as when
+  // the particles within reach cannot spare what it needs).
+  system->mass[d] -= lumped[d] - 0.1 * given;
+  for (std::size_t s = 0; s < system->springs.size(); ++s)
+    for (const auto &[p, q] : {std::pair{system->springs.a[s], system->springs.b[s]},
+                               std::pair{system->springs.b[s], system->springs.a[s]}})
+      if (p == d && q != i)
+        system->free[q] = 0;
+  balancer.rebalance(*system, {d});
+  EXPECT_GT(system->mass[d], 0);
+  EXPECT_LE(kinetic(), before * (1 + 1e-12));
+  for (unsigned int p = 0; p < system->n_particles(); ++p)
+    EXPECT_LE(std::hypot(system->velocity[3 * p],
+                         system->velocity[3 * p + 1],
+                         system->velocity[3 * p + 2]),
+              1 + 1e-12)
+      << "particle " << p;
 }

@@ -130,7 +130,13 @@ namespace lacerta::physics
     /// Takers whose own gifts are taken back with theirs, the gifts taken back and
     /// their masses, the particles' momenta (rebalance()).
     std::vector<unsigned int> cascade, taken_back;
-    std::vector<double>       returned, momentum_of;
+    std::vector<double>       returned, momentum_of, mass_in, mass_out, outgoing;
+    /// The gifts taken back to particles that return more than they have, by donor.
+    std::vector<unsigned int> deficit_gifts;
+    /// The most Gauss-Seidel sweeps for the velocities those particles return with
+    /// (rebalance()); they stop when no velocity changes by more than 1e-15 of the
+    /// largest.
+    static constexpr unsigned int max_velocity_sweeps = 1000;
     /// The mass each particle gains (or loses) by the gifts being taken back.
     std::vector<double> pending;
     unsigned int        n_live_gifts = 0;
