@@ -393,9 +393,9 @@ namespace lacerta::physics
     // took the cells of a donor that was also a taker) first receives, then returns
     // at the velocity it then has, u = (m v + Σ m_g u_g) / (m + Σ m_g) over the gifts
     // coming back to it; those velocities can depend on each other along chains of
-    // gifts, so they are iterated. Returning at the velocity before receiving would
-    // divide the momentum of what comes back by the small mass left, and create
-    // kinetic energy. A mass made negative by a cut counts as 0 in the means.
+    // gifts, so they are solved by Gauss-Seidel sweeps. Returning at the velocity before
+    // receiving would divide the momentum of what comes back by the small mass left, and
+    // create kinetic energy. A mass made negative by a cut counts as 0 in the means.
     for (const unsigned int p : touched)
     {
       mass_in[p]  = 0;
@@ -408,16 +408,6 @@ namespace lacerta::physics
       mass_out[gifts[g].taker] += returned[g];
       mass_in[gifts[g].donor] += returned[g];
     }
-    const auto receive = [&]
-    {
-      for (const unsigned int p : touched)
-        for (unsigned int c = 0; c < 3; ++c)
-          momentum_of[3 * p + c] = 0;
-      for (const unsigned int g : taken_back)
-        for (unsigned int c = 0; c < 3; ++c)
-          momentum_of[3 * gifts[g].donor + c] +=
-            returned[g] * outgoing[3 * gifts[g].taker + c];
-    };
     const auto returns_more_than_it_has = [&](const unsigned int p)
     { return system.mass[p] < mass_out[p] && mass_in[p] > 0; };
     // Their velocities by Gauss-Seidel sweeps over the gifts coming back to them
@@ -458,7 +448,14 @@ namespace lacerta::physics
       if (change <= 1e-15 * scale)
         break;
     }
-    receive();
+    // What each particle receives, at the velocities the gifts return with.
+    for (const unsigned int p : touched)
+      for (unsigned int c = 0; c < 3; ++c)
+        momentum_of[3 * p + c] = 0;
+    for (const unsigned int g : taken_back)
+      for (unsigned int c = 0; c < 3; ++c)
+        momentum_of[3 * gifts[g].donor + c] +=
+          returned[g] * outgoing[3 * gifts[g].taker + c];
     for (const unsigned int p : touched)
     {
       const double kept = std::max(system.mass[p] - mass_out[p], 0.0);

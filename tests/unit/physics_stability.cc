@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "physics_test_support.h"
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <random>

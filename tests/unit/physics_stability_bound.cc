@@ -80,8 +80,10 @@ namespace lacerta
         EXPECT_GT(system.n_particles(), before) << model << ": the strokes cut nothing";
         // The true frequency of the springs (the first model has nothing else).
         if (model == "linear springs")
+        {
           EXPECT_GE(bound.bound().omega,
                     test_support::true_highest_frequency(system) * (1 - 1e-12));
+        }
       }
     EXPECT_EQ(n_compared, 3u * 3u * 16u);
   }

@@ -37,12 +37,11 @@ namespace lacerta::physics
      * Updates the bound after a local change of the system: the particles listed in
      * @p changed (ParticleSystem::changed_particles(), repeats allowed) and the
      * appended ones get new weights (gershgorin_row_weight(), refined_row_weight()),
-     * and they and their
-     * neighbours are bounded again at the current positions; the others keep their
-     * bound and weight. Computes everything if the system has no mesh
-     * with local updates whose edges are its springs, if every particle counts as
-     * changed
-     * (ParticleSystem::all_particles_changed()), or if compute() was never called.
+     * and they and their neighbours are bounded again at the current positions; the
+     * others keep their bound and weights. Computes everything if the system has no
+     * mesh with local updates whose edges are its springs, if every particle counts
+     * as changed (ParticleSystem::all_particles_changed()), or if compute() was never
+     * called.
      */
     void
     update(const ParticleSystem &system, const std::vector<unsigned int> &changed);
