@@ -1158,7 +1158,7 @@ namespace lacerta::cut
     physics::SpringSet &springs = system.springs;
     // Springs follow the edges: appended, moved into retired slots, restiffened.
     const auto &edges = mesh.get_edges();
-    for (unsigned int i = 0; i < edge_update.n_added; ++i)
+    for (unsigned int i = 0; i < edge_update.n_added_edges; ++i)
     {
       const unsigned int e = static_cast<unsigned int>(springs.size());
       changed_springs.push_back(e);
@@ -1167,7 +1167,7 @@ namespace lacerta::cut
                         0.0,
                         norm(sub(mesh.vertex(edges[e][1]), mesh.vertex(edges[e][0]))));
     }
-    for (const auto &[to, from] : edge_update.moves)
+    for (const auto &[to, from] : edge_update.edge_moves)
     {
       // The mesh copied its last edge `from` into slot `to`: so do the springs.
       Assert(from + 1 == springs.size(), dealii::ExcInternalError());

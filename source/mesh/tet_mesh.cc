@@ -591,17 +591,18 @@ namespace lacerta::mesh
                         const std::vector<Tet>                         &added,
                         const std::vector<std::array<unsigned int, 4>> &face_ids,
                         std::vector<unsigned int>                      &added_ids,
-                        EdgeUpdate                                     &update)
+                        Update                                         &update)
   {
-    if (added.size() < removed.size() || face_ids.size() != added.size())
+    if (face_ids.size() != added.size())
       throw_error("TetMesh::replace_tets: ",
-                  removed.size(),
-                  " tetrahedra cannot be replaced by ",
                   added.size(),
-                  ".");
+                  " tetrahedra come with ",
+                  face_ids.size(),
+                  " lists of face boundary ids.");
     ReplaceScratch &scratch = replace_scratch;
-    update.n_added          = 0;
-    update.moves.clear();
+    update.n_added_edges    = 0;
+    update.edge_moves.clear();
+    update.tet_moves.clear();
     // Edge ids of the new tets, looked up while the old tets are still in place, so
     // that an edge that survives keeps its id (and its spring). Edges not found are
     // numbered in the order they first appear. A small hash table of the edges seen
@@ -659,7 +660,7 @@ namespace lacerta::mesh
           {
             id = static_cast<unsigned int>(edges.size());
             edges.push_back({{a, b}});
-            ++update.n_added;
+            ++update.n_added_edges;
           }
           slot = {{a, b, id}};
         }
@@ -768,9 +769,12 @@ namespace lacerta::mesh
                                { return scratch.tet_stamp[t] == scratch.stamp; });
 
     // Put the new tets in: the first ones into the removed ones' slots, the others
-    // appended (the arrays grow once, not once per tet).
+    // appended (the arrays grow once, not once per tet). Slots left free are filled
+    // at the end.
     added_ids.resize(added.size());
-    const std::size_t n_old = tets.size(), n_new = n_old + added.size() - removed.size();
+    const std::size_t n_old = tets.size(),
+                      n_new =
+                        n_old + std::max(added.size(), removed.size()) - removed.size();
     tets.resize(n_new);
     tet_edge_ids.resize(n_new);
     neighbors.resize(4 * n_new, invalid_index);
@@ -781,8 +785,10 @@ namespace lacerta::mesh
                                   ? removed[k]
                                   : static_cast<unsigned int>(n_old + k - removed.size());
       added_ids[k]            = slot;
-      tets[slot]              = added[k];
-      tet_edge_ids[slot]      = new_edge_ids[k];
+      if (k < removed.size())
+        scratch.tet_stamp[slot] = 0;
+      tets[slot]         = added[k];
+      tet_edge_ids[slot] = new_edge_ids[k];
       for (const unsigned int id : new_edge_ids[k])
         ++edge_uses[id];
       for (const unsigned int v : added[k])
@@ -898,7 +904,7 @@ namespace lacerta::mesh
                                return false;
                              });
       }
-      update.moves.push_back({{r, last}});
+      update.edge_moves.push_back({{r, last}});
       edges.pop_back();
       edge_uses.pop_back();
     }
@@ -926,6 +932,114 @@ namespace lacerta::mesh
       }
       boundary_vertex[v] = on_boundary;
     }
+
+    // Fewer tets came than went: the slots still marked removed are filled from the
+    // end, a free slot below the new size with the last tet that is not free.
+    if (added.size() < removed.size())
+    {
+      auto &holes = scratch.dead;
+      holes.assign(removed.begin() + added.size(), removed.end());
+      std::sort(holes.begin(), holes.end());
+      const std::size_t n_kept = tets.size() - holes.size();
+      std::size_t       from   = tets.size();
+      for (const unsigned int to : holes)
+      {
+        if (to >= n_kept)
+          break;
+        do
+          --from;
+        while (scratch.tet_stamp[from] == scratch.stamp);
+        move_tet(static_cast<unsigned int>(from), to);
+        update.tet_moves.push_back({{to, static_cast<unsigned int>(from)}});
+      }
+      for (const auto &[to, moved] : update.tet_moves)
+        for (unsigned int &id : added_ids)
+          if (id == moved)
+            id = to;
+      tets.resize(n_kept);
+      tet_edge_ids.resize(n_kept);
+      neighbors.resize(4 * n_kept);
+      boundary_slot.resize(4 * n_kept);
+      scratch.tet_stamp.resize(n_kept);
+    }
+  }
+
+
+  void
+  TetMesh::move_tet(const unsigned int from, const unsigned int to)
+  {
+    tets[to]         = tets[from];
+    tet_edge_ids[to] = tet_edge_ids[from];
+    for (unsigned int f = 0; f < 4; ++f)
+    {
+      const unsigned int n    = neighbors[4 * from + f];
+      neighbors[4 * to + f]   = n;
+      neighbors[4 * from + f] = invalid_index;
+      if (n != invalid_index)
+        for (unsigned int g = 0; g < 4; ++g)
+          if (neighbors[4 * n + g] == from)
+            neighbors[4 * n + g] = to;
+      const unsigned int slot     = boundary_slot[4 * from + f];
+      boundary_slot[4 * to + f]   = slot;
+      boundary_slot[4 * from + f] = invalid_index;
+      if (slot != invalid_index)
+        boundary_faces[slot].tet = to;
+    }
+    for (const unsigned int v : tets[to])
+    {
+      vertex_tets.erase(v, from);
+      vertex_tets.insert(v, to);
+    }
+  }
+
+
+  void
+  TetMesh::remove_vertices(std::vector<unsigned int>                 dead,
+                           std::vector<std::array<unsigned int, 2>> &moves)
+  {
+    // Largest first, so that the last vertex moved into a free slot is always a live
+    // one (every dead vertex above it is gone already).
+    std::sort(dead.rbegin(), dead.rend());
+    dead.erase(std::unique(dead.begin(), dead.end()), dead.end());
+    std::vector<unsigned int> star;
+    for (const unsigned int r : dead)
+    {
+      if (r >= vertices.size() || vertex_tets.star_size(r) != 0)
+        throw_error("TetMesh::remove_vertices: vertex ",
+                    r,
+                    " of ",
+                    vertices.size(),
+                    " is still held by a tetrahedron or does not exist.");
+      const unsigned int last = static_cast<unsigned int>(vertices.size() - 1);
+      if (r != last)
+      {
+        vertices[r]        = vertices[last];
+        boundary_vertex[r] = boundary_vertex[last];
+        star.assign(vertex_tets[last].begin(), vertex_tets[last].end());
+        for (const unsigned int t : star)
+        {
+          vertex_tets.insert(r, t);
+          for (unsigned int &w : tets[t])
+            if (w == last)
+              w = r;
+          for (const unsigned int id : tet_edge_ids[t])
+          {
+            auto &edge = edges[id];
+            if (edge[0] != last && edge[1] != last)
+              continue;
+            const unsigned int other = edge[0] == last ? edge[1] : edge[0];
+            edge                     = {{std::min(other, r), std::max(other, r)}};
+          }
+        }
+        vertex_tets.erase_marked(last, [](const unsigned int) { return true; });
+        moves.push_back({{r, last}});
+      }
+      vertices.pop_back();
+      boundary_vertex.pop_back();
+      vertex_tets.resize(vertices.size());
+    }
+    replace_scratch.vertex_stamp.resize(vertices.size());
+    replace_scratch.fresh_stamp.resize(vertices.size());
   }
 
 

@@ -161,15 +161,15 @@ TEST(TetMesh, ReplacingCellsApartFromEachOtherKeepsTheirEdges)
   for (unsigned int t = 0; t < 4; ++t)
     edges_before.push_back(mesh.tet_edges(t));
   std::vector<unsigned int>                ids;
-  TetMesh::EdgeUpdate                      update;
+  TetMesh::Update                          update;
   std::vector<std::array<unsigned int, 4>> face_ids(4, {{1, 1, 1, 1}});
   std::vector<Tet>                         added;
   for (unsigned int t = 0; t < 4; ++t)
     added.push_back(mesh.tet(t));
   mesh.replace_tets({0, 1, 2, 3}, added, face_ids, ids, update);
   EXPECT_EQ(mesh.n_edges(), n_edges);
-  EXPECT_EQ(update.n_added, 0u);
-  EXPECT_TRUE(update.moves.empty());
+  EXPECT_EQ(update.n_added_edges, 0u);
+  EXPECT_TRUE(update.edge_moves.empty());
   for (unsigned int t = 0; t < 4; ++t)
   {
     EXPECT_EQ(ids[t], t);
@@ -365,6 +365,42 @@ namespace
       EXPECT_EQ(listed_star, star) << where << ", vertex " << v;
     }
   }
+
+  /// A box of @p n x @p n x @p n unit cubes, six tetrahedra each (around the cube's
+  /// diagonal), with local updates enabled.
+  TetMesh
+  box_of_cubes(const unsigned int n)
+  {
+    std::vector<Point3> points;
+    const auto          index = [n](unsigned int i, unsigned int j, unsigned int k)
+    { return (k * (n + 1) + j) * (n + 1) + i; };
+    for (unsigned int k = 0; k <= n; ++k)
+      for (unsigned int j = 0; j <= n; ++j)
+        for (unsigned int i = 0; i <= n; ++i)
+          points.push_back({double(i), double(j), double(k)});
+    std::vector<Tet>                                 cells;
+    const std::array<std::array<unsigned int, 3>, 6> paths = {
+      {{{0, 1, 2}}, {{0, 2, 1}}, {{1, 0, 2}}, {{1, 2, 0}}, {{2, 0, 1}}, {{2, 1, 0}}}};
+    for (unsigned int k = 0; k < n; ++k)
+      for (unsigned int j = 0; j < n; ++j)
+        for (unsigned int i = 0; i < n; ++i)
+          for (const auto &path : paths)
+          {
+            std::array<unsigned int, 3> c{{i, j, k}};
+            Tet                         t;
+            t[0] = index(c[0], c[1], c[2]);
+            for (unsigned int s = 0; s < 3; ++s)
+            {
+              ++c[path[s]];
+              t[s + 1] = index(c[0], c[1], c[2]);
+            }
+            cells.push_back(t);
+          }
+    TetMesh mesh(points, cells, "box");
+    mesh.enable_local_updates();
+    mesh.reserve(2 * mesh.n_vertices(), 4 * mesh.n_tets());
+    return mesh;
+  }
 } // namespace
 
 
@@ -378,35 +414,7 @@ TEST(TetMesh, RandomLocalReplacementsMatchTheReferenceAndARebuild)
   // the neighbours and the boundary face list, in order, are those of the plain
   // reference, and neighbours, boundary faces, edges, stars and boundary flags those
   // of the cells alone.
-  const unsigned int  n = 4;
-  std::vector<Point3> points;
-  const auto          index = [n](unsigned int i, unsigned int j, unsigned int k)
-  { return (k * (n + 1) + j) * (n + 1) + i; };
-  for (unsigned int k = 0; k <= n; ++k)
-    for (unsigned int j = 0; j <= n; ++j)
-      for (unsigned int i = 0; i <= n; ++i)
-        points.push_back({double(i), double(j), double(k)});
-  std::vector<Tet>                                 cells;
-  const std::array<std::array<unsigned int, 3>, 6> paths = {
-    {{{0, 1, 2}}, {{0, 2, 1}}, {{1, 0, 2}}, {{1, 2, 0}}, {{2, 0, 1}}, {{2, 1, 0}}}};
-  for (unsigned int k = 0; k < n; ++k)
-    for (unsigned int j = 0; j < n; ++j)
-      for (unsigned int i = 0; i < n; ++i)
-        for (const auto &path : paths)
-        {
-          std::array<unsigned int, 3> c{{i, j, k}};
-          Tet                         t;
-          t[0] = index(c[0], c[1], c[2]);
-          for (unsigned int s = 0; s < 3; ++s)
-          {
-            ++c[path[s]];
-            t[s + 1] = index(c[0], c[1], c[2]);
-          }
-          cells.push_back(t);
-        }
-  TetMesh mesh(points, cells, "box");
-  mesh.enable_local_updates();
-  mesh.reserve(2 * mesh.n_vertices(), 4 * mesh.n_tets());
+  TetMesh mesh = box_of_cubes(4);
 
   std::mt19937 rng(20261122);
   const auto   pick = [&](const std::size_t size)
@@ -545,7 +553,7 @@ TEST(TetMesh, RandomLocalReplacementsMatchTheReferenceAndARebuild)
     ReferenceMesh             reference(mesh);
     const auto                edges_before = mesh.get_edges();
     std::vector<unsigned int> ids;
-    TetMesh::EdgeUpdate       update;
+    TetMesh::Update           update;
     mesh.replace_tets(removed, added, face_ids, ids, update);
     reference.replace(removed, added, face_ids);
     ++done;
@@ -567,8 +575,9 @@ TEST(TetMesh, RandomLocalReplacementsMatchTheReferenceAndARebuild)
     // The edge update replayed on the old edge list gives the new one where it
     // names a surviving edge: a surviving edge keeps its spring.
     std::vector<std::array<unsigned int, 2>> replay = edges_before;
-    replay.resize(edges_before.size() + update.n_added, {{invalid_index, invalid_index}});
-    for (const auto &[to, from] : update.moves)
+    replay.resize(edges_before.size() + update.n_added_edges,
+                  {{invalid_index, invalid_index}});
+    for (const auto &[to, from] : update.edge_moves)
     {
       replay[to] = replay[from];
       replay.pop_back();
@@ -585,4 +594,117 @@ TEST(TetMesh, RandomLocalReplacementsMatchTheReferenceAndARebuild)
   }
   EXPECT_GT(done, 60u);
   EXPECT_GT(closed, 5u);
+}
+
+
+TEST(TetMesh, EdgeCollapsesRemoveCellsAndVerticesLocally)
+{
+  // Random edge collapses (b onto a: the cells with both go, b's other cells take a),
+  // as a decimation or a coarser level of detail makes them: fewer cells come than go
+  // and b is left without cells. After each one the moves replayed on the old cells
+  // and vertices give the new ones, the new cells are where their ids say, and the
+  // connectivity is that of the cells alone.
+  TetMesh      mesh = box_of_cubes(4);
+  std::mt19937 rng(20261128);
+  unsigned int done = 0, moved_tets = 0, moved_vertices = 0;
+  for (unsigned int step = 0; step < 300 && done < 40; ++step)
+  {
+    const unsigned int t =
+      std::uniform_int_distribution<unsigned int>(0, mesh.n_tets() - 1)(rng);
+    const unsigned int e = std::uniform_int_distribution<unsigned int>(0, 5)(rng);
+    const unsigned int a = mesh.tet(t)[TetMesh::edge_vertices[e][0]],
+                       b = mesh.tet(t)[TetMesh::edge_vertices[e][1]];
+    std::vector<unsigned int> removed;
+    std::vector<Tet>          added;
+    bool                      legal         = true;
+    const auto                signed_volume = [&](const Tet &cell)
+    {
+      const Point3 &p = mesh.vertex(cell[0]);
+      double        d[3][3];
+      for (unsigned int i = 0; i < 3; ++i)
+        for (unsigned int c = 0; c < 3; ++c)
+          d[i][c] = mesh.vertex(cell[i + 1])[c] - p[c];
+      return d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1])
+             - d[0][1] * (d[1][0] * d[2][2] - d[1][2] * d[2][0])
+             + d[0][2] * (d[1][0] * d[2][1] - d[1][1] * d[2][0]);
+    };
+    for (unsigned int c = 0; c < mesh.n_tets(); ++c)
+    {
+      const Tet &cell = mesh.tet(c);
+      if (std::count(cell.begin(), cell.end(), b) == 0)
+        continue;
+      removed.push_back(c);
+      if (std::count(cell.begin(), cell.end(), a) == 0)
+      {
+        Tet moved = cell;
+        std::replace(moved.begin(), moved.end(), b, a);
+        // A legal collapse flattens or turns over no cell.
+        legal = legal && signed_volume(moved) * signed_volume(cell) > 1e-12;
+        added.push_back(moved);
+      }
+    }
+    // The caller's guarantee: a face between a removed and a surviving cell is a
+    // face of a new cell (a collapse of a boundary edge can uncover one).
+    std::set<std::array<unsigned int, 3>> new_faces;
+    for (const Tet &cell : added)
+      for (unsigned int f = 0; f < 4; ++f)
+        new_faces.insert(face_of(cell, f));
+    bool covered = true;
+    for (const unsigned int r : removed)
+      for (unsigned int f = 0; f < 4; ++f)
+      {
+        const unsigned int n = mesh.neighbor(r, f);
+        if (n != invalid_index && std::count(removed.begin(), removed.end(), n) == 0)
+          covered = covered && new_faces.count(face_of(mesh.tet(r), f)) != 0;
+      }
+    if (!legal || !covered || !stays_manifold(mesh.get_tets(), removed, added))
+      continue;
+    std::shuffle(removed.begin(), removed.end(), rng);
+    const std::string      where       = "collapse " + std::to_string(done);
+    const std::vector<Tet> tets_before = mesh.get_tets();
+    std::vector<Point3>    points_before;
+    for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
+      points_before.push_back(mesh.vertex(v));
+    std::vector<std::array<unsigned int, 4>> face_ids(added.size(), {{0, 0, 0, 0}});
+    std::vector<unsigned int>                ids;
+    TetMesh::Update                          update;
+    mesh.replace_tets(removed, added, face_ids, ids, update);
+    std::vector<Tet> replay = tets_before;
+    for (std::size_t k = 0; k < added.size(); ++k)
+      replay[removed[k]] = added[k];
+    for (const auto &[to, from] : update.tet_moves)
+      replay[to] = replay[from];
+    replay.resize(tets_before.size() - (removed.size() - added.size()));
+    ASSERT_EQ(mesh.get_tets(), replay) << where;
+    for (std::size_t k = 0; k < added.size(); ++k)
+      ASSERT_EQ(mesh.tet(ids[k]), added[k]) << where;
+    moved_tets += static_cast<unsigned int>(update.tet_moves.size());
+
+    std::vector<std::array<unsigned int, 2>> moves;
+    mesh.remove_vertices({b}, moves);
+    ASSERT_EQ(mesh.n_vertices(), points_before.size() - 1) << where;
+    std::vector<unsigned int> renamed(points_before.size());
+    for (unsigned int v = 0; v < renamed.size(); ++v)
+      renamed[v] = v;
+    for (const auto &[to, from] : moves)
+    {
+      points_before[to] = points_before[from];
+      renamed[from]     = to;
+    }
+    points_before.pop_back();
+    for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
+      ASSERT_EQ(mesh.vertex(v), points_before[v]) << where;
+    for (unsigned int c = 0; c < mesh.n_tets(); ++c)
+      for (unsigned int i = 0; i < 4; ++i)
+        ASSERT_EQ(mesh.tet(c)[i], renamed[replay[c][i]]) << where;
+    moved_vertices += static_cast<unsigned int>(moves.size());
+    expect_connectivity_from_scratch(mesh, where);
+    ++done;
+  }
+  EXPECT_EQ(done, 40u);
+  EXPECT_GT(moved_tets, 0u);
+  EXPECT_GT(moved_vertices, 0u);
+  // A vertex that a cell still holds is refused.
+  std::vector<std::array<unsigned int, 2>> moves;
+  EXPECT_THROW(mesh.remove_vertices({mesh.tet(0)[0]}, moves), std::exception);
 }

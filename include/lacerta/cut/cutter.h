@@ -449,7 +449,7 @@ namespace lacerta::cut
     std::vector<std::array<unsigned int, 4>> face_ids;
     std::vector<std::array<unsigned int, 2>> incidences;
     std::vector<StarCell>                    star;
-    mesh::TetMesh::EdgeUpdate                edge_update;
+    mesh::TetMesh::Update                edge_update;
     /// The end of the last lap().
     std::chrono::steady_clock::time_point lap_start;
     /// The springs the sweeps of the current blade motion added, moved or restiffened,

@@ -199,15 +199,18 @@ namespace lacerta::mesh
     sort_spatially();
 
     /**
-     * What replace_tets() did to the unique edges, so that arrays indexed by edge id
-     * (the springs) can follow: first `n_added` edges were appended, then every pair
-     * (to, from) of `moves`, in order, copied edge `from` (the last one) into slot `to`
-     * and dropped the last slot.
+     * What replace_tets() did to the ids, so that arrays indexed by edge or by
+     * tetrahedron (the springs, a force model's per-cell data) can follow: first
+     * `n_added_edges` edges were appended, then every pair (to, from) of `edge_moves`,
+     * in order, copied edge `from` (the last one) into slot `to` and dropped the last
+     * slot. When fewer tetrahedra came than went, every pair (to, from) of `tet_moves`
+     * moved tetrahedron `from` (from the end) into the free slot `to`, in order.
      */
-    struct EdgeUpdate
+    struct Update
     {
-      unsigned int                             n_added = 0;
-      std::vector<std::array<unsigned int, 2>> moves;
+      unsigned int                             n_added_edges = 0;
+      std::vector<std::array<unsigned int, 2>> edge_moves;
+      std::vector<std::array<unsigned int, 2>> tet_moves;
     };
 
     /**
@@ -312,21 +315,35 @@ namespace lacerta::mesh
     add_vertex(const Point3 &x);
 
     /**
-     * Replaces the tetrahedra @p removed by @p added (at least as many), updating
-     * neighbours, boundary faces, edges and boundary flags locally: the cost is
-     * proportional to the number of tetrahedra involved and the size of their vertex
-     * stars, not to the mesh size. The first added tetrahedra take the slots of the
-     * removed ones, the others are appended; their ids are returned in @p added_ids.
+     * Replaces the tetrahedra @p removed by @p added, updating neighbours, boundary
+     * faces, edges and boundary flags locally: the cost is proportional to the number
+     * of tetrahedra involved and the size of their vertex stars, not to the mesh size.
+     * The first added tetrahedra take the slots of the removed ones, the others are
+     * appended; when fewer come than go, the last tetrahedra fill the slots left
+     * (`update.tet_moves`). The added ones' final ids are returned in @p added_ids.
      * A face of an added tetrahedron that finds no neighbour becomes a boundary face
      * with id @p face_boundary_ids[k][f]. The caller guarantees that the result is
-     * conforming (the cutter does, by deciding every cut from global ids).
+     * conforming and that every face between a removed and a surviving tetrahedron
+     * is a face of an added one (the cutter does, by deciding every cut from global
+     * ids; a level of detail, by swapping whole fragments of the MT).
      */
     void
     replace_tets(const std::vector<unsigned int>                &removed,
                  const std::vector<Tet>                         &added,
                  const std::vector<std::array<unsigned int, 4>> &face_boundary_ids,
                  std::vector<unsigned int>                      &added_ids,
-                 EdgeUpdate                                     &edge_update);
+                 Update                                         &update);
+
+    /**
+     * Removes the vertices @p dead, which no tetrahedron may hold any more (an error
+     * otherwise), keeping the ids compact: every pair (to, from) appended to @p moves
+     * moved vertex `from` (the last one) into the free slot `to`, in order, and renamed
+     * it in its tetrahedra and edges (an edge's ends stay ordered). Local: the cost is
+     * that of the moved vertices' stars (needs local updates).
+     */
+    void
+    remove_vertices(std::vector<unsigned int>                 dead,
+                    std::vector<std::array<unsigned int, 2>> &moves);
 
     /// Writes or reads the state for a checkpoint (see lacerta::Archive).
     void
@@ -357,6 +374,10 @@ namespace lacerta::mesh
     /// Adds boundary face (t, f) with @p id.
     void
     add_boundary_face(unsigned int t, unsigned int f, unsigned int id);
+
+    /// Moves tetrahedron @p from into the free slot @p to (replace_tets()).
+    void
+    move_tet(unsigned int from, unsigned int to);
 
     /// For local updates: the tetrahedra around every vertex.
     VertexStars vertex_tets;
