@@ -102,8 +102,7 @@ namespace lacerta::cut
                  const Blade                       &initial)
       : mesh(mesh_in)
       , system(system_in)
-      , density(density_in)
-      , youngs_modulus(youngs_modulus_in)
+      , topology(mesh_in, system_in, density_in, youngs_modulus_in)
       , integral_of_density(integral)
       , parameters(parameters_in)
       , current(initial)
@@ -135,11 +134,6 @@ namespace lacerta::cut
                      lengths.end());
     typical_edge = lengths[lengths.size() / 2];
     tree.build(mesh, system.position.data());
-    if (const auto sigma = physics::constant_value(density))
-      constant_density_mass.emplace(*sigma);
-    else
-      constant_density_mass.reset();
-    constant_youngs_modulus = physics::constant_value(youngs_modulus);
     tet_stamp.assign(mesh.n_tets(), 0);
     edge_stamp.assign(mesh.n_edges(), 0);
     on_surface.assign(mesh.n_vertices(), 0);
@@ -412,11 +406,10 @@ namespace lacerta::cut
     if (statistics.changed)
     {
       const auto t0 = Clock::now();
-      system.springs_changed(changed_springs);
+      topology.notify_force_model();
       statistics.reinit_seconds =
         std::chrono::duration<double>(Clock::now() - t0).count();
     }
-    changed_springs.clear();
     return statistics;
   }
 
@@ -914,44 +907,6 @@ namespace lacerta::cut
   }
 
 
-  Cutter::CellTerms
-  Cutter::cell_terms(const unsigned int t) const
-  {
-    // A constant density and Young's modulus (the common case) need no Function call
-    // and one volume per cell instead of two; the masses and stiffness factors are the
-    // same to the last bit.
-    if (constant_density_mass && constant_youngs_modulus)
-    {
-      const double volume = mesh.volume(t);
-      return {(*constant_density_mass)(volume), *constant_youngs_modulus * volume};
-    }
-    return {constant_density_mass ? (*constant_density_mass)(mesh.volume(t))
-                                  : physics::tet_mass_contributions(mesh, t, density),
-            physics::tet_stiffness_factor(mesh, t, youngs_modulus)};
-  }
-
-
-  void
-  Cutter::add_cell_terms(const unsigned int t, const double sign, double &integral_delta)
-  {
-    physics::SpringSet          &springs = system.springs;
-    const CellTerms              terms   = cell_terms(t);
-    const std::array<double, 4> &m       = terms.mass;
-    for (unsigned int i = 0; i < 4; ++i)
-    {
-      system.mass[mesh.tet(t)[i]] += sign * m[i];
-      touched_vertices.push_back(mesh.tet(t)[i]);
-      integral_delta += sign * m[i];
-    }
-    const double f = sign * terms.stiffness_factor;
-    for (const unsigned int e : mesh.tet_edges(t))
-    {
-      springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
-      changed_springs.push_back(e);
-    }
-  }
-
-
   unsigned int
   Cutter::new_particle(const Point       &rest,
                        const unsigned int parent,
@@ -1153,42 +1108,20 @@ namespace lacerta::cut
 
 
   void
-  Cutter::update_springs_and_masses(double &integral_delta)
+  Cutter::index_new_boundary_faces()
   {
-    physics::SpringSet &springs = system.springs;
-    // Springs follow the edges: appended, moved into retired slots, restiffened.
-    const auto &edges = mesh.get_edges();
-    for (unsigned int i = 0; i < edge_update.n_added_edges; ++i)
-    {
-      const unsigned int e = static_cast<unsigned int>(springs.size());
-      changed_springs.push_back(e);
-      springs.push_back(edges[e][0],
-                        edges[e][1],
-                        0.0,
-                        norm(sub(mesh.vertex(edges[e][1]), mesh.vertex(edges[e][0]))));
-    }
-    for (const auto &[to, from] : edge_update.edge_moves)
-    {
-      // The mesh copied its last edge `from` into slot `to`: so do the springs.
-      Assert(from + 1 == springs.size(), dealii::ExcInternalError());
-      changed_springs.push_back(to);
-      springs.retire(to);
-    }
     prepare_scratch();
     for (const unsigned int t : added_ids)
-    {
-      add_cell_terms(t, +1, integral_delta);
       for (unsigned int f = 0; f < 4; ++f)
         if (mesh.neighbor(t, f) == mesh::invalid_index)
           tree.add_face(mesh, t, f);
-    }
     // A vertex that lost all its cells cannot happen (copies take over whole stars),
     // but a mass that rounding left a hair below zero would be nonsense: clamp. A mass
     // further below zero is a particle that gave mass to its neighbours
     // (physics::MassBalancer) and lost cells since: the balancer raises it again, and
     // clamping it would add mass.
     const double rounding = 1e-12 * std::abs(integral_of_density);
-    for (const unsigned int v : touched_vertices)
+    for (const unsigned int v : topology.touched_particles())
       if (system.mass[v] < 0 && system.mass[v] > -rounding)
         system.mass[v] = 0;
   }
@@ -1233,10 +1166,9 @@ namespace lacerta::cut
     // edges (by edge id, before the mesh update moves the ids; a spring whose edge
     // dies is retired with it). Every spring gets these terms first and those of the
     // new cells after, in the order of the cells.
-    touched_vertices.clear();
-    double integral_delta = 0;
-    for (const unsigned int r : removed)
-      add_cell_terms(r, -1, integral_delta);
+    topology.clear_touched();
+    const double mass_before = topology.mass_delta();
+    topology.take_out(removed);
     lap(statistics.physics_seconds);
 
     // The record of this sweep for the Multi-Triangulation (set_recorder()).
@@ -1252,11 +1184,11 @@ namespace lacerta::cut
     lap(statistics.children_seconds);
 
     // The mesh, locally.
-    mesh.replace_tets(removed, children, face_ids, added_ids, edge_update);
+    added_ids = topology.replace(removed, children, face_ids);
     lap(statistics.mesh_seconds);
 
-    update_springs_and_masses(integral_delta);
-    integral_of_density += integral_delta;
+    index_new_boundary_faces();
+    integral_of_density += topology.mass_delta() - mass_before;
     update_active_cells(end);
     statistics.changed = true;
     lap(statistics.physics_seconds);

@@ -44,7 +44,11 @@ namespace lacerta::physics
   void
   ParticleRanges::append_particles(const ParticleSystem &system)
   {
-    const unsigned int n  = system.n_particles();
+    // Particles removed from the end (a coarser level of detail) shorten the last
+    // ranges, which may become empty.
+    const unsigned int n = system.n_particles();
+    for (unsigned int &first : first_particle)
+      first = std::min(first, n);
     first_particle.back() = n;
     const std::size_t old = inverse_mass.size();
     inverse_mass.resize(n);

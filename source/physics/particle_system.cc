@@ -79,11 +79,13 @@ namespace lacerta::physics
   void
   ParticleSystem::springs_changed(const std::vector<unsigned int> &changed_springs)
   {
+    // Springs removed from the end since are listed too: they have no ends now.
     for (const unsigned int s : changed_springs)
-    {
-      note_changed(springs.a[s]);
-      note_changed(springs.b[s]);
-    }
+      if (s < springs.size())
+      {
+        note_changed(springs.a[s]);
+        note_changed(springs.b[s]);
+      }
     forces->springs_changed(*this, changed_springs);
   }
 
@@ -114,6 +116,43 @@ namespace lacerta::physics
     free.push_back(1.0);
     note_changed(n_particles() - 1);
     return n_particles() - 1;
+  }
+
+
+  void
+  ParticleSystem::remove_particles(const std::vector<std::array<unsigned int, 2>> &moves,
+                                   const unsigned int n_removed)
+  {
+    for (const auto &[to, from] : moves)
+    {
+      for (std::vector<double> *v : {&position, &velocity, &external_force, &rest})
+        for (unsigned int d = 0; d < 3; ++d)
+          (*v)[3 * std::size_t(to) + d] = (*v)[3 * std::size_t(from) + d];
+      mass[to]       = mass[from];
+      mass_shift[to] = mass_shift[from];
+      free[to]       = free[from];
+    }
+    const std::size_t n = n_particles() - std::size_t(n_removed);
+    for (std::vector<double> *v : {&position, &velocity, &external_force, &rest})
+      v->resize(3 * n);
+    mass.resize(n);
+    mass_shift.resize(n);
+    free.resize(n);
+    if (all_changed)
+      return;
+    // A slot that was listed and refilled holds a moved particle, which is listed
+    // anyway; slots past the end go.
+    std::size_t kept = 0;
+    for (const unsigned int i : changed)
+      if (i < n)
+        changed[kept++] = i;
+      else
+        listed[i] = 0;
+    changed.resize(kept);
+    listed.resize(n, 0);
+    for (const auto &move : moves)
+      if (move[0] < n)
+        note_changed(move[0]);
   }
 
 

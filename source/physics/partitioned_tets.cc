@@ -72,7 +72,12 @@ namespace lacerta::physics
       build(system, ranges);
       return;
     }
-    const unsigned int known = static_cast<unsigned int>(copies.size());
+    // Slots past the mesh's end (fewer cells came than went: the last ones filled the
+    // freed slots, which are among the changed cells) lose their copies first.
+    for (std::size_t t = mesh.n_tets(); t < copies.size(); ++t)
+      remove_copies(static_cast<unsigned int>(t));
+    const unsigned int known =
+      static_cast<unsigned int>(std::min<std::size_t>(copies.size(), mesh.n_tets()));
     copies.resize(mesh.n_tets());
     seen.resize(mesh.n_tets(), 0);
     ++update_count;

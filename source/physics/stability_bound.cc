@@ -33,6 +33,14 @@ namespace lacerta::physics
     }
     const unsigned int n      = system.n_particles();
     const unsigned int before = static_cast<unsigned int>(lambda.size());
+    // Particles removed from the end (a coarser level of detail) leave the tournament
+    // first, while their bounds can still be read.
+    for (unsigned int i = n; i < before; ++i)
+    {
+      tree[leaves + i] = none;
+      for (unsigned int k = (leaves + i) / 2; k >= 1; k /= 2)
+        tree[k] = beats(tree[2 * k + 1], tree[2 * k]) ? tree[2 * k + 1] : tree[2 * k];
+    }
     lambda.resize(n, 0.0);
     stiffest.resize(n, 0);
     first_weights.resize(n, 1.0);

@@ -11,7 +11,7 @@
 #include <lacerta/cut/split_table.h>
 #include <lacerta/cut/tool.h>
 #include <lacerta/mesh/tet_mesh.h>
-#include <lacerta/physics/assembly.h>
+#include <lacerta/physics/topology_update.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -308,20 +308,6 @@ namespace lacerta::cut
     void
     apply(const Blade &end, CutStepStatistics &statistics);
 
-    /// A cell's lumped mass contributions (Section 3.1) and its stiffness factor
-    /// E·V (Section 3.2).
-    struct CellTerms
-    {
-      std::array<double, 4> mass;
-      double                stiffness_factor;
-    };
-    /// The terms of cell @p t.
-    CellTerms
-    cell_terms(unsigned int t) const;
-    /// Adds @p sign (+1 or -1) times cell @p t's terms to its particles' masses and
-    /// its edges' springs, and the mass added to @p integral_delta.
-    void
-    add_cell_terms(unsigned int t, double sign, double &integral_delta);
     /// A particle at rest position @p rest in cell @p parent, its state interpolated.
     unsigned int
     new_particle(const Point &rest, unsigned int parent, CutStepStatistics &statistics);
@@ -333,10 +319,10 @@ namespace lacerta::cut
     /// faces not on the cut (separate_star()).
     void
     separate_points_on_cut(CutStepStatistics &statistics, CutRecord *record);
-    /// After the mesh update: springs follow the edges, the new cells' terms are added
-    /// (their mass to @p integral_delta), their boundary faces indexed.
+    /// After the mesh update: the new cells' boundary faces indexed, masses that
+    /// rounding left a hair below zero clamped.
     void
-    update_springs_and_masses(double &integral_delta);
+    index_new_boundary_faces();
     /// The active cells: the new ones blade @p end is in.
     void
     update_active_cells(const Blade &end);
@@ -349,17 +335,13 @@ namespace lacerta::cut
     void
     lap(double &phase);
 
-    mesh::TetMesh                     &mesh;
-    physics::ParticleSystem           &system;
-    const dealii::Function<3, double> &density;
-    const dealii::Function<3, double> &youngs_modulus;
-    double                            &integral_of_density;
-    /// The mass contributions if the density is constant (physics::constant_value()).
-    std::optional<physics::ConstantDensityMass> constant_density_mass;
-    /// Young's modulus if it is constant (physics::constant_value()).
-    std::optional<double> constant_youngs_modulus;
-    Parameters            parameters;
-    Blade                 current;
+    mesh::TetMesh           &mesh;
+    physics::ParticleSystem &system;
+    /// The local update of the mesh, masses and springs every sweep makes.
+    physics::TopologyUpdate topology;
+    double                 &integral_of_density;
+    Parameters              parameters;
+    Blade                   current;
     /// Typical edge length at rest (median), for the sub-division when nothing is active.
     double                    typical_edge = 0;
     BoundaryFaceTree          tree;
@@ -440,21 +422,16 @@ namespace lacerta::cut
     std::vector<unsigned int> fresh_mark;
     std::vector<std::uint8_t> in_star;
     unsigned int              analysis_stamp = 0, affected_stamp = 0, merge_stamp = 0;
-    std::vector<unsigned int> affected, around, removed, added_ids, touched_vertices,
-      star_group, copy_ids;
-    std::vector<TetCut>                      cuts;
-    std::vector<SplitResult>                 results;
-    std::vector<mesh::Tet>                   children;
-    std::vector<std::uint8_t>                child_cut_faces;
+    std::vector<unsigned int> affected, around, removed, added_ids, star_group, copy_ids;
+    std::vector<TetCut>       cuts;
+    std::vector<SplitResult>  results;
+    std::vector<mesh::Tet>    children;
+    std::vector<std::uint8_t> child_cut_faces;
     std::vector<std::array<unsigned int, 4>> face_ids;
     std::vector<std::array<unsigned int, 2>> incidences;
     std::vector<StarCell>                    star;
-    mesh::TetMesh::Update                edge_update;
     /// The end of the last lap().
     std::chrono::steady_clock::time_point lap_start;
-    /// The springs the sweeps of the current blade motion added, moved or restiffened,
-    /// passed to ParticleSystem::springs_changed() at its end.
-    std::vector<unsigned int> changed_springs;
     /// Where sweeps are recorded (set_recorder()), or nullptr.
     std::vector<CutRecord> *recorder = nullptr;
     /// Per child of the sweep being applied, when recording: (split, child of the split).

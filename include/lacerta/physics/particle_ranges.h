@@ -75,7 +75,8 @@ namespace lacerta::physics
 
     /**
      * The system gained particles (a cut): they join the last range, and their inverse
-     * masses are read.
+     * masses are read. Or it lost its last particles (a coarser level of detail): the
+     * ranges past the new end shrink, possibly to nothing.
      */
     void
     append_particles(const ParticleSystem &system);

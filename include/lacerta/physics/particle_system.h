@@ -154,6 +154,17 @@ namespace lacerta::physics
                  const std::array<double, 3> &v);
 
     /**
+     * Removes @p n_removed particles the way TetMesh::remove_vertices() removed their
+     * vertices: every pair (to, from) of @p moves, in order, copies particle `from`
+     * into slot `to`, then the last @p n_removed slots go. The springs are the
+     * caller's (they follow the mesh's edges). The moved particles count as changed
+     * (changed_particles()); the removed ones leave that list.
+     */
+    void
+    remove_particles(const std::vector<std::array<unsigned int, 2>> &moves,
+                     unsigned int                                     n_removed);
+
+    /**
      * The particles whose springs, mass or existence changed locally since
      * clear_changes(), each once, in the order first reported: the ends of the springs
      * passed to springs_changed() (the particles whose tetrahedra changed are among

@@ -1,0 +1,158 @@
+/**
+ * @file
+ * "These cells leave, these cells arrive": the one local update of a mesh and its
+ * particle system that cuts, tears and changes of the level of detail share.
+ */
+#pragma once
+
+#include <lacerta/mesh/tet_mesh.h>
+#include <lacerta/physics/assembly.h>
+
+#include <array>
+#include <optional>
+#include <vector>
+
+namespace lacerta::physics
+{
+  class ParticleSystem;
+
+  /**
+   * Replaces tetrahedra of a mesh and follows the change in the particle system whose
+   * particles are the mesh's vertices, locally: the cells that go take their lumped
+   * masses (Section 3.1) and their share E·V/|e|² of their edges' springs (Section
+   * 3.2) out, the mesh is changed by TetMesh::replace_tets(), the springs follow the
+   * edges (appended, moved into retired slots), the cells that come put their terms
+   * in, and particles left without cells are removed. The springs changed since the
+   * last notify_force_model() are then passed to the force model at once. The cost is
+   * proportional to the cells and particles involved, never to the mesh.
+   *
+   * A change is made of these stages, in this order: take_out() of the cells that go
+   * (while the mesh still has them), any new particles (the caller adds them to both
+   * the mesh and the system), replace(), then remove_particles() of the vertices
+   * left without cells, and notify_force_model().
+   */
+  class TopologyUpdate
+  {
+  public:
+    /**
+     * Updates @p mesh (local updates are enabled) and @p system with the masses of
+     * density @p density times @p mass_scale and the springs of Young's modulus
+     * @p youngs_modulus, the rules compute_masses() and compute_springs() follow.
+     */
+    TopologyUpdate(mesh::TetMesh                     &mesh,
+                   ParticleSystem                    &system,
+                   const dealii::Function<3, double> &density,
+                   const dealii::Function<3, double> &youngs_modulus,
+                   double                             mass_scale = 1.0);
+
+    /// A cell's lumped mass contributions (Section 3.1) and its stiffness factor E·V
+    /// (Section 3.2).
+    struct CellTerms
+    {
+      std::array<double, 4> mass;
+      double                stiffness_factor;
+    };
+
+    /// The terms of cell @p t of the mesh as it is now.
+    CellTerms
+    cell_terms(unsigned int t) const;
+
+    /// Takes the terms of the cells @p removed out of their particles' masses and
+    /// their edges' springs (before replace() removes them).
+    void
+    take_out(const std::vector<unsigned int> &removed);
+
+    /**
+     * Replaces the cells @p removed by @p added in the mesh (TetMesh::replace_tets(),
+     * with boundary ids @p face_ids), makes the springs follow the edges and puts the
+     * new cells' terms in. Returns the new cells' ids.
+     */
+    const std::vector<unsigned int> &
+    replace(const std::vector<unsigned int>                &removed,
+            const std::vector<mesh::Tet>                   &added,
+            const std::vector<std::array<unsigned int, 4>> &face_ids);
+
+    /**
+     * Scales the masses the last replace() put in so that they equal those the last
+     * take_out() took out plus the (lumped) masses the particles removed since still
+     * held: the total mass stays what it was although the new cells cover a slightly
+     * different volume (a coarser or finer boundary of a level of detail; Section
+     * 3.1's total ∫σ is kept exactly). Call before notify_force_model().
+     */
+    void
+    conserve_mass();
+
+    /**
+     * Removes the vertices @p dead (held by no cell any more) from the mesh and their
+     * particles from the system (TetMesh::remove_vertices()); the springs of the
+     * particles moved into the freed slots take their new ends. Returns the moves
+     * (to, from), in order, which arrays by particle held elsewhere follow.
+     */
+    const std::vector<std::array<unsigned int, 2>> &
+    remove_particles(const std::vector<unsigned int> &dead);
+
+    /// Passes the springs changed since the last call to the system's force model
+    /// (ParticleSystem::springs_changed()); does nothing if none changed.
+    void
+    notify_force_model();
+
+    /// What the last replace() did to the mesh's ids.
+    const mesh::TetMesh::Update &
+    mesh_update() const
+    {
+      return update_of_mesh;
+    }
+
+    /// The particles whose masses take_out() and replace() changed since
+    /// clear_touched(), with repetitions.
+    const std::vector<unsigned int> &
+    touched_particles() const
+    {
+      return touched;
+    }
+
+    /// Empties touched_particles().
+    void
+    clear_touched()
+    {
+      touched.clear();
+    }
+
+    /// The mass put in minus the mass taken out since the update was made (kg).
+    double
+    mass_delta() const
+    {
+      return delta;
+    }
+
+    /// The rest volume put in minus the rest volume taken out since the update was
+    /// made (m^3).
+    double
+    volume_delta() const
+    {
+      return volume_change;
+    }
+
+  private:
+    /// Adds @p sign (+1 or -1) times cell @p t's terms to its particles' masses and
+    /// its edges' springs.
+    void
+    add_cell_terms(unsigned int t, double sign);
+
+    mesh::TetMesh                           &mesh;
+    ParticleSystem                          &system;
+    const dealii::Function<3, double>       &density;
+    const dealii::Function<3, double>       &youngs_modulus;
+    double                                   mass_scale;
+    std::optional<ConstantDensityMass>       constant_density_mass;
+    std::optional<double>                    constant_youngs_modulus;
+    mesh::TetMesh::Update                    update_of_mesh;
+    std::vector<unsigned int>                added_ids, touched, changed_springs;
+    std::vector<std::array<unsigned int, 2>> vertex_moves;
+    double                                   delta = 0, volume_change = 0;
+    /// The masses the last take_out() took out and the last replace() put in (kg).
+    double taken_out = 0, put_in = 0;
+    /// The lumped masses the particles removed since the last take_out() held (kg).
+    double removed_mass = 0;
+  };
+} // namespace lacerta::physics

@@ -1,0 +1,181 @@
+#include <lacerta/mesh/point.h>
+#include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/topology_update.h>
+
+namespace lacerta::physics
+{
+  TopologyUpdate::TopologyUpdate(mesh::TetMesh                     &mesh_in,
+                                 ParticleSystem                    &system_in,
+                                 const dealii::Function<3, double> &density_in,
+                                 const dealii::Function<3, double> &youngs_modulus_in,
+                                 const double                       mass_scale_in)
+      : mesh(mesh_in)
+      , system(system_in)
+      , density(density_in)
+      , youngs_modulus(youngs_modulus_in)
+      , mass_scale(mass_scale_in)
+  {
+    mesh.enable_local_updates();
+    if (const auto sigma = constant_value(density))
+      constant_density_mass.emplace(*sigma);
+    constant_youngs_modulus = constant_value(youngs_modulus);
+  }
+
+
+  TopologyUpdate::CellTerms
+  TopologyUpdate::cell_terms(const unsigned int t) const
+  {
+    // A constant density and Young's modulus (the common case) need no Function call
+    // and one volume per cell instead of two; the masses and stiffness factors are the
+    // same to the last bit.
+    CellTerms terms;
+    if (constant_density_mass && constant_youngs_modulus)
+    {
+      const double volume = mesh.volume(t);
+      terms = {(*constant_density_mass)(volume), *constant_youngs_modulus * volume};
+    }
+    else
+      terms = {constant_density_mass ? (*constant_density_mass)(mesh.volume(t))
+                                     : tet_mass_contributions(mesh, t, density),
+               tet_stiffness_factor(mesh, t, youngs_modulus)};
+    if (mass_scale != 1.0)
+      for (double &m : terms.mass)
+        m *= mass_scale;
+    return terms;
+  }
+
+
+  void
+  TopologyUpdate::add_cell_terms(const unsigned int t, const double sign)
+  {
+    SpringSet       &springs = system.springs;
+    const CellTerms  terms   = cell_terms(t);
+    const mesh::Tet &tet     = mesh.tet(t);
+    for (unsigned int i = 0; i < 4; ++i)
+    {
+      system.mass[tet[i]] += sign * terms.mass[i];
+      touched.push_back(tet[i]);
+      delta += sign * terms.mass[i];
+      (sign > 0 ? put_in : taken_out) += terms.mass[i];
+    }
+    volume_change += sign * mesh.volume(t);
+    const double f = sign * terms.stiffness_factor;
+    for (const unsigned int e : mesh.tet_edges(t))
+    {
+      springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
+      changed_springs.push_back(e);
+    }
+  }
+
+
+  void
+  TopologyUpdate::take_out(const std::vector<unsigned int> &removed)
+  {
+    taken_out    = 0;
+    removed_mass = 0;
+    for (const unsigned int t : removed)
+      add_cell_terms(t, -1);
+  }
+
+
+  const std::vector<unsigned int> &
+  TopologyUpdate::replace(const std::vector<unsigned int>                &removed,
+                          const std::vector<mesh::Tet>                   &added,
+                          const std::vector<std::array<unsigned int, 4>> &face_ids)
+  {
+    mesh.replace_tets(removed, added, face_ids, added_ids, update_of_mesh);
+    // Springs follow the edges: appended, moved into retired slots, restiffened.
+    SpringSet  &springs = system.springs;
+    const auto &edges   = mesh.get_edges();
+    for (unsigned int i = 0; i < update_of_mesh.n_added_edges; ++i)
+    {
+      const unsigned int e = static_cast<unsigned int>(springs.size());
+      changed_springs.push_back(e);
+      springs.push_back(edges[e][0],
+                        edges[e][1],
+                        0.0,
+                        mesh::distance(mesh.vertex(edges[e][1]),
+                                       mesh.vertex(edges[e][0])));
+    }
+    for (const auto &[to, from] : update_of_mesh.edge_moves)
+    {
+      // The mesh copied its last edge `from` into slot `to`: so do the springs.
+      (void)from;
+      changed_springs.push_back(to);
+      springs.retire(to);
+    }
+    // A cell moved into a freed slot keeps its particles and springs, but the force
+    // model's data by cell must follow it: its edges count as changed.
+    for (const auto &move : update_of_mesh.tet_moves)
+      for (const unsigned int e : mesh.tet_edges(move[0]))
+        changed_springs.push_back(e);
+    put_in = 0;
+    for (const unsigned int t : added_ids)
+      add_cell_terms(t, +1);
+    return added_ids;
+  }
+
+
+  void
+  TopologyUpdate::conserve_mass()
+  {
+    if (!(put_in > 0))
+      return;
+    const double extra = (taken_out + removed_mass) / put_in - 1;
+    for (const unsigned int t : added_ids)
+    {
+      const CellTerms  terms = cell_terms(t);
+      const mesh::Tet &tet   = mesh.tet(t);
+      for (unsigned int i = 0; i < 4; ++i)
+      {
+        system.mass[tet[i]] += extra * terms.mass[i];
+        delta += extra * terms.mass[i];
+      }
+    }
+    put_in       = taken_out + removed_mass;
+    removed_mass = 0;
+  }
+
+
+  const std::vector<std::array<unsigned int, 2>> &
+  TopologyUpdate::remove_particles(const std::vector<unsigned int> &dead)
+  {
+    // What the particles still hold (rounding, earlier corrections of
+    // conserve_mass()) leaves with them; a redistributed share (mass_shift) is the
+    // mass balancer's to settle.
+    for (const unsigned int v : dead)
+      removed_mass += system.mass[v] - system.mass_shift[v];
+    vertex_moves.clear();
+    mesh.remove_vertices(dead, vertex_moves);
+    system.remove_particles(vertex_moves, static_cast<unsigned int>(dead.size()));
+    // The springs of a moved particle take its new id as their end, in the order of
+    // the mesh's edge (lower id first).
+    SpringSet  &springs = system.springs;
+    const auto &edges   = mesh.get_edges();
+    for (const auto &move : vertex_moves)
+    {
+      const unsigned int v = move[0];
+      if (v >= mesh.n_vertices())
+        continue;
+      for (const unsigned int t : mesh.tets_of_vertex(v))
+        for (const unsigned int e : mesh.tet_edges(t))
+          if (edges[e][0] == v || edges[e][1] == v)
+          {
+            springs.a[e] = edges[e][0];
+            springs.b[e] = edges[e][1];
+            changed_springs.push_back(e);
+          }
+    }
+    return vertex_moves;
+  }
+
+
+  void
+  TopologyUpdate::notify_force_model()
+  {
+    if (changed_springs.empty())
+      return;
+    system.springs_changed(changed_springs);
+    changed_springs.clear();
+  }
+} // namespace lacerta::physics
