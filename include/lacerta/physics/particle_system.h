@@ -162,7 +162,7 @@ namespace lacerta::physics
      */
     void
     remove_particles(const std::vector<std::array<unsigned int, 2>> &moves,
-                     unsigned int                                     n_removed);
+                     unsigned int                                    n_removed);
 
     /**
      * The particles whose springs, mass or existence changed locally since
