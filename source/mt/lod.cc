@@ -61,6 +61,7 @@ namespace lacerta::mt
   void
   Lod::activate(const std::uint32_t t)
   {
+    activations.push_back({t, +1});
     position[t] = static_cast<std::uint32_t>(active.size());
     active.push_back(t);
     ++active_fine[mt->creator[t]];
@@ -76,6 +77,7 @@ namespace lacerta::mt
   void
   Lod::deactivate(const std::uint32_t t)
   {
+    activations.push_back({t, -1});
     const std::uint32_t last = active.back();
     active[position[t]]      = last;
     position[last]           = position[t];
@@ -267,6 +269,7 @@ namespace lacerta::mt
     for (const std::uint32_t j : changed_list)
       changed[j] = 0;
     changed_list.clear();
+    activations.clear();
     if (++stamp == 0)
     {
       std::fill(need_stamp.begin(), need_stamp.end(), 0);
@@ -369,6 +372,29 @@ namespace lacerta::mt
       std::make_heap(checks.begin(), checks.end(), std::greater<>());
     }
     return n_last_applied + n_last_undone > 0;
+  }
+
+
+  void
+  Lod::last_swap(std::vector<std::uint32_t> &removed,
+                 std::vector<std::uint32_t> &added) const
+  {
+    removed.clear();
+    added.clear();
+    std::vector<std::pair<std::uint32_t, int>> sorted = activations;
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t i = 0; i < sorted.size();)
+    {
+      int         net = 0;
+      std::size_t j   = i;
+      for (; j < sorted.size() && sorted[j].first == sorted[i].first; ++j)
+        net += sorted[j].second;
+      if (net > 0)
+        added.push_back(sorted[i].first);
+      else if (net < 0)
+        removed.push_back(sorted[i].first);
+      i = j;
+    }
   }
 
 

@@ -4,6 +4,8 @@
 #include <lacerta/base/parsed_function.h>
 #include <lacerta/cut/tool.h>
 #include <lacerta/mt/multiresolution.h>
+#include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/topology_update.h>
 
 #include <deal.II/base/function_parser.h>
 
@@ -229,10 +231,7 @@ namespace lacerta::mt
     last_focus = now;
     last_step  = step;
     query->set_focus(now);
-    if (!lod->extract(*query))
-      return false;
-    make_active_mesh();
-    return true;
+    return lod->extract(*query);
   }
 
 
@@ -244,7 +243,11 @@ namespace lacerta::mt
     // The cut mesh stays: replayed, the records make the level of detail this mesh.
     // The MT ids of its new particles are appended in their order, after every id the
     // MT had, so the list stays increasing.
+    const std::size_t          known      = vertices.size();
     const MtCutter::Statistics statistics = mt_cutter->apply(records, vertices, *lod);
+    mesh_vertex_of.resize(mt.n_vertices(), mesh::invalid_index);
+    for (std::size_t i = known; i < vertices.size(); ++i)
+      mesh_vertex_of[vertices[i]] = static_cast<std::uint32_t>(i);
     if (vertices.size() != mesh.n_vertices())
       throw_error("Multiresolution: internal error, the MT knows ",
                   vertices.size(),
@@ -260,57 +263,111 @@ namespace lacerta::mt
   {
     vertices = lod->active_vertices();
     mesh     = lod->make_mesh(vertices, "level of detail");
+    mesh_vertex_of.assign(mt.n_vertices(), mesh::invalid_index);
+    for (std::size_t i = 0; i < vertices.size(); ++i)
+      mesh_vertex_of[vertices[i]] = static_cast<std::uint32_t>(i);
   }
 
 
-  void
-  Multiresolution::transfer_state(const std::vector<std::uint32_t> &old_vertices,
-                                  const std::vector<double>        &old_x,
-                                  const std::vector<double>        &old_v,
-                                  std::vector<double>              &x,
-                                  std::vector<double>              &v)
+  unsigned int
+  Multiresolution::mesh_tet_of(const std::uint32_t t) const
   {
-    const auto old_index = [&old_vertices](const std::uint32_t g)
-    {
-      const auto found = std::lower_bound(old_vertices.begin(), old_vertices.end(), g);
-      return (found != old_vertices.end() && *found == g)
-               ? static_cast<std::size_t>(found - old_vertices.begin())
-               : static_cast<std::size_t>(-1);
-    };
-    n_kept = n_new = 0;
-    for (std::size_t i = 0; i < vertices.size(); ++i)
-    {
-      const std::size_t o = old_index(vertices[i]);
-      if (o != static_cast<std::size_t>(-1))
+    std::array<unsigned int, 4> corners;
+    for (unsigned int k = 0; k < 4; ++k)
+      corners[k] = mesh_vertex_of[mt.tets[t][k]];
+    if (corners[0] != mesh::invalid_index)
+      for (const unsigned int c : mesh.tets_of_vertex(corners[0]))
       {
-        ++n_kept;
-        for (unsigned int d = 0; d < 3; ++d)
-        {
-          x[3 * i + d] = old_x[3 * o + d];
-          v[3 * i + d] = old_v[3 * o + d];
-        }
-        continue;
+        const mesh::Tet &q = mesh.tet(c);
+        if (std::is_permutation(q.begin(), q.end(), corners.begin()))
+          return c;
       }
-      ++n_new;
-      auto [tet, lambda] = lod->locate_in_previous(vertices[i]);
-      double sum         = 0;
-      for (double &l : lambda)
-        sum += (l = std::max(l, 0.0));
-      for (unsigned int d = 0; d < 3; ++d)
-        x[3 * i + d] = v[3 * i + d] = 0;
-      for (unsigned int k = 0; k < 4; ++k)
-      {
-        const std::size_t corner = old_index(mt.tets[tet][k]);
-        if (corner == static_cast<std::size_t>(-1))
-          throw_error("Multiresolution: internal error, the tetrahedron found for a new "
-                      "vertex is not in the previous level of detail.");
-        for (unsigned int d = 0; d < 3; ++d)
-        {
-          x[3 * i + d] += lambda[k] / sum * old_x[3 * corner + d];
-          v[3 * i + d] += lambda[k] / sum * old_v[3 * corner + d];
-        }
-      }
+    throw_error("Multiresolution: internal error, MT tetrahedron ",
+                t,
+                " of the previous level of detail is not in its mesh.");
+  }
+
+
+  const std::vector<std::array<unsigned int, 2>> &
+  Multiresolution::apply_change(physics::TopologyUpdate &topology,
+                                physics::ParticleSystem &system)
+  {
+    lod->last_swap(mt_removed, mt_added);
+    mesh_vertex_of.resize(mt.n_vertices(), mesh::invalid_index);
+    // The cells that go, while the mesh still has them, and their vertices.
+    removed.clear();
+    held.clear();
+    for (const std::uint32_t t : mt_removed)
+    {
+      removed.push_back(mesh_tet_of(t));
+      held.insert(held.end(),
+                  mesh.tet(removed.back()).begin(),
+                  mesh.tet(removed.back()).end());
     }
+    // The vertices that come, with the state the previous level had where they are.
+    n_new = 0;
+    for (const std::uint32_t t : mt_added)
+      for (const std::uint32_t g : mt.tets[t])
+      {
+        if (mesh_vertex_of[g] != mesh::invalid_index)
+          continue;
+        auto [previous, lambda] = lod->locate_in_previous(g);
+        double sum              = 0;
+        for (double &l : lambda)
+          sum += (l = std::max(l, 0.0));
+        std::array<double, 3> x{{0, 0, 0}}, v{{0, 0, 0}};
+        for (unsigned int k = 0; k < 4; ++k)
+        {
+          const std::uint32_t corner = mesh_vertex_of[mt.tets[previous][k]];
+          if (corner == mesh::invalid_index)
+            throw_error("Multiresolution: internal error, the tetrahedron found for a "
+                        "new vertex is not in the previous level of detail.");
+          for (unsigned int d = 0; d < 3; ++d)
+          {
+            x[d] += lambda[k] / sum * system.position[3 * std::size_t(corner) + d];
+            v[d] += lambda[k] / sum * system.velocity[3 * std::size_t(corner) + d];
+          }
+        }
+        const mesh::Point3 &rest = mt.vertices[g];
+        mesh_vertex_of[g]        = mesh.add_vertex(rest);
+        system.add_particle({{rest[0], rest[1], rest[2]}}, x, v);
+        vertices.push_back(g);
+        ++n_new;
+      }
+    n_kept = vertices.size() - n_new;
+    added.clear();
+    for (const std::uint32_t t : mt_added)
+    {
+      mesh::Tet cell;
+      for (unsigned int k = 0; k < 4; ++k)
+        cell[k] = mesh_vertex_of[mt.tets[t][k]];
+      added.push_back(cell);
+    }
+    // The boundary faces of a level of detail carry no id (as make_mesh() gives them).
+    face_ids.assign(added.size(), {{0, 0, 0, 0}});
+    topology.take_out(removed);
+    topology.replace(removed, added, face_ids);
+    // The vertices only the cells that went held.
+    dead.clear();
+    for (const unsigned int w : held)
+      if (mesh.tets_of_vertex(w).empty())
+        dead.push_back(w);
+    std::sort(dead.begin(), dead.end());
+    dead.erase(std::unique(dead.begin(), dead.end()), dead.end());
+    for (const unsigned int w : dead)
+      mesh_vertex_of[vertices[w]] = mesh::invalid_index;
+    vertex_moves = topology.remove_particles(dead);
+    for (const auto &[to, from] : vertex_moves)
+    {
+      vertices[to]                 = vertices[from];
+      mesh_vertex_of[vertices[to]] = to;
+    }
+    vertices.resize(mesh.n_vertices());
+    // The region swapped keeps its mass: a coarser or finer boundary covers a
+    // slightly different volume, and the total stays ∫σ.
+    topology.conserve_mass();
+    topology.notify_force_model();
+    return vertex_moves;
   }
 
 
@@ -351,7 +408,8 @@ namespace lacerta::mt
   Multiresolution::serialize(Archive &archive)
   {
     archive.section("multiresolution");
-    archive(mt, *query, last_focus, last_step, mesh, vertices, n_kept, n_new);
+    archive(
+      mt, *query, last_focus, last_step, mesh, vertices, mesh_vertex_of, n_kept, n_new);
     lod->serialize(archive, *query);
     bool     has_mt_cutter = mt_cutter != nullptr;
     archive &has_mt_cutter;

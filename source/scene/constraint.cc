@@ -7,6 +7,7 @@
 #include <deal.II/base/utilities.h>
 
 #include <algorithm>
+#include <unordered_map>
 
 namespace lacerta::scene
 {
@@ -32,6 +33,38 @@ namespace lacerta::scene
       if (std::binary_search(extended.begin(), extended.end(), original))
         extended.insert(std::upper_bound(extended.begin(), extended.end(), copy), copy);
     initialize(extended, system);
+  }
+
+
+  void
+  Constraint::follow_moves(const std::vector<std::array<unsigned int, 2>> &moves,
+                           physics::ParticleSystem                        &system)
+  {
+    // Where each of the constraint's particles is in the list, followed move by move
+    // (a particle can move twice).
+    std::unordered_map<unsigned int, std::size_t> place;
+    for (std::size_t i = 0; i < particles.size(); ++i)
+      place[particles[i]] = i;
+    std::vector<unsigned int> renamed = particles;
+    for (const auto &[to, from] : moves)
+    {
+      const auto found = place.find(from);
+      if (found == place.end())
+        continue;
+      const std::size_t i = found->second;
+      place.erase(found);
+      renamed[i] = to;
+      place[to]  = i;
+    }
+    for (const unsigned int p : renamed)
+      if (p >= system.n_particles())
+        throw_error("Constraint '",
+                    name,
+                    "': internal error, its particle ",
+                    p,
+                    " was removed by a change of the level of detail.");
+    std::sort(renamed.begin(), renamed.end());
+    initialize(renamed, system);
   }
 
 

@@ -10,6 +10,7 @@
 #include <lacerta/physics/force_model.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/stability.h>
+#include <lacerta/physics/topology_update.h>
 #include <lacerta/scene/region.h>
 #include <lacerta/scene/scene.h>
 
@@ -122,14 +123,15 @@ namespace lacerta::scene
   void
   Scene::follow_change(const SystemChange &change)
   {
-    if (!change.reassembled())
+    // A change of level has made the constraints follow its moves already.
+    if (change.cause != SystemChange::Cause::level_of_detail)
       for (auto &constraint : constraints)
         constraint->follow_copies(change.copied_particles(), *system);
     if (change.cause == SystemChange::Cause::cut && lacerator)
       lacerator->mesh_changed();
     if (change.cause != SystemChange::Cause::cut)
       restart_cutter();
-    if (change.reassembled() && lacerator)
+    if (change.cause == SystemChange::Cause::level_of_detail && lacerator)
     {
       // Particles the MT's cuts created: among them the lacerator finds those of its
       // tears again.
@@ -201,15 +203,25 @@ namespace lacerta::scene
   }
 
 
-  template <typename Transfer>
-  void
-  Scene::move_to_level_of_detail(const double t, const Transfer &transfer)
+  const std::vector<std::array<unsigned int, 2>> &
+  Scene::move_to_level_of_detail(const double t)
   {
-    const std::vector<double> old_x = system->position, old_v = system->velocity;
-    assemble(multiresolution->active_mesh(), t);
-    transfer(old_x, old_v, system->position, system->velocity);
+    if (!level_update)
+      level_update =
+        std::make_unique<physics::TopologyUpdate>(multiresolution->mesh_to_cut(),
+                                                  *system,
+                                                  material.density(),
+                                                  material.youngs_modulus(),
+                                                  level_mass_scale);
+    const double volume_before = level_update->volume_delta();
+    const std::vector<std::array<unsigned int, 2>> &moves =
+      multiresolution->apply_change(*level_update, *system);
+    level_of_detail_volume += level_update->volume_delta() - volume_before;
+    for (auto &constraint : constraints)
+      constraint->follow_moves(moves, *system);
     system->enforce_constraints(t, system->position.data(), system->velocity.data());
-    system->update_force_model(n_threads);
+    update_loads(t);
+    return moves;
   }
 
 
@@ -254,8 +266,9 @@ namespace lacerta::scene
       // A coarser boundary covers a slightly different volume; the total mass stays
       // the integral of the density over the object (Section 3.1).
       const double total = std::accumulate(system->mass.begin(), system->mass.end(), 0.0);
+      level_mass_scale   = integral_of_density / total;
       for (double &m : system->mass)
-        m *= integral_of_density / total;
+        m *= level_mass_scale;
     }
     for (unsigned int i = 0; i < system->n_particles(); ++i)
       if (!(system->mass[i] > 0) || !std::isfinite(system->mass[i]))
@@ -316,19 +329,14 @@ namespace lacerta::scene
     // whose new particles the MT does not know yet: re-extraction waits for the update.
     if (!multiresolution || cut_pending())
       return false;
-    const std::vector<std::uint32_t> old_vertices = multiresolution->active_vertices();
     if (!multiresolution->update(t, step, cutter ? &cutter->blade() : nullptr))
       return false;
-    move_to_level_of_detail(
-      t,
-      [&](const std::vector<double> &old_x,
-          const std::vector<double> &old_v,
-          std::vector<double>       &x,
-          std::vector<double>       &v)
-      { multiresolution->transfer_state(old_vertices, old_x, old_v, x, v); });
+    const std::vector<std::array<unsigned int, 2>> &moves = move_to_level_of_detail(t);
     multiresolution->print_change(
       out, t, std::accumulate(system->mass.begin(), system->mass.end(), 0.0));
-    system_changed(SystemChange{SystemChange::Cause::level_of_detail, t});
+    SystemChange change{SystemChange::Cause::level_of_detail, t};
+    change.particle_moves = &moves;
+    system_changed(change);
     return true;
   }
 
@@ -405,6 +413,7 @@ namespace lacerta::scene
     archive.section("scene");
     archive(
       mesh, integral_of_density, initial_volume, level_of_detail_volume, cut_records);
+    archive &level_mass_scale;
     archive(multiresolution, *system);
     archive.section("constraints");
     for (auto &constraint : constraints)

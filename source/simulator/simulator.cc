@@ -682,25 +682,24 @@ namespace lacerta
     physics::ParticleSystem &system = *scene->system;
     if (mass_balancer)
     {
-      // A local change is balanced locally (nothing global per cut); a new level of
-      // detail, whose masses are all lumped anew, as a whole.
+      // A cut or a tear is balanced locally (nothing global per cut); a change of the
+      // level of detail, which renumbers particles the ledger names, as a whole.
       const physics::MassBalanceStatistics b =
-        change.reassembled() || system.all_particles_changed()
+        change.cause == scene::SystemChange::Cause::level_of_detail
+            || system.all_particles_changed()
           ? mass_balancer->balance(system)
           : mass_balancer->rebalance(system, system.changed_particles());
       redistribution.largest_moved   = std::max(redistribution.largest_moved, b.moved);
       redistribution.last_unresolved = b.unresolved;
       ++redistribution.n_balances;
     }
-    // A new level of detail is checked by its extraction; a local change here.
-    if (change.cause != scene::SystemChange::Cause::level_of_detail)
-      check(step);
+    check(step);
     integrator->initialize(system);
-    if (change.reassembled() || system.all_particles_changed())
+    if (system.all_particles_changed())
     {
-      // Every particle is new (or counts as changed): the blow-up monitor checks the new
-      // state against its ledger at once, so that a change that puts particles far off
-      // stops the run naming it, then restarts; the bound is computed anew.
+      // Every particle counts as changed: the blow-up monitor checks the new state
+      // against its ledger at once, so that a change that puts particles far off stops
+      // the run naming it, then restarts; the bound is computed anew.
       monitor->restart(system, step, change.time, change.describe());
       stability_bound->compute(system);
     }

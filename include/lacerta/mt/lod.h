@@ -89,6 +89,16 @@ namespace lacerta::mt
       return {{n_last_applied, n_last_undone}};
     }
 
+    /**
+     * What the last extract() changed: the MT tetrahedra that were active before it
+     * and are not now, into @p removed, and those active now and not before, into
+     * @p added, each sorted (a tetrahedron that came and went within the extraction is
+     * in neither).
+     */
+    void
+    last_swap(std::vector<std::uint32_t> &removed,
+              std::vector<std::uint32_t> &added) const;
+
     /// The vertices of the active tetrahedra, sorted.
     std::vector<std::uint32_t>
     active_vertices() const;
@@ -220,5 +230,8 @@ namespace lacerta::mt
     std::uint32_t stamp            = 0;
     unsigned int  n_last_applied   = 0;
     unsigned int  n_last_undone    = 0;
+    /// The tetrahedra activate() (+1) and deactivate() (-1) changed since the last
+    /// extract() began, in order (last_swap()).
+    std::vector<std::pair<std::uint32_t, int>> activations;
   };
 } // namespace lacerta::mt

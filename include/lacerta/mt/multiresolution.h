@@ -36,6 +36,11 @@ namespace lacerta
 {
   class Archive;
 }
+namespace lacerta::physics
+{
+  class ParticleSystem;
+  class TopologyUpdate;
+} // namespace lacerta::physics
 namespace lacerta::mt
 {
   /**
@@ -74,9 +79,31 @@ namespace lacerta::mt
      * Re-extracts if the focus at time @p time (step @p step) has moved far enough or
      * the interval has passed; returns whether the level of detail changed. With
      * `Focus follows = tool` the focus is at @p blade, the blade where the tool now is.
+     * The active mesh does not change yet: apply_change() makes the change.
      */
     bool
     update(double time, unsigned int step, const cut::Blade *blade);
+
+    /**
+     * Moves the active mesh and @p system (whose particles are its vertices) to the
+     * level of detail the last update() extracted, locally, through @p topology (the
+     * same update a cut makes): the fragments that went leave, those that came
+     * arrive, the vertices only they held are removed, and the region keeps its mass
+     * (TopologyUpdate::conserve_mass()). A vertex that comes gets its
+     * state interpolated in the previous level's tetrahedron that contains it
+     * (Lod::locate_in_previous(), barycentric coordinates clamped to it, Section 4.2).
+     * Returns the moves (to, from) of the particles renumbered into freed slots, in
+     * order (TetMesh::remove_vertices()).
+     */
+    const std::vector<std::array<unsigned int, 2>> &
+    apply_change(physics::TopologyUpdate &topology, physics::ParticleSystem &system);
+
+    /// The particles apply_change() added (the last ones of the system).
+    unsigned int
+    n_new_particles() const
+    {
+      return static_cast<unsigned int>(n_new);
+    }
 
     /// The mesh of the current level of detail (vertices numbered compactly).
     const mesh::TetMesh &
@@ -106,27 +133,13 @@ namespace lacerta::mt
     MtCutter::Statistics
     apply_cut(const std::vector<cut::CutRecord> &records);
 
-    /// The MT vertex id of every vertex of active_mesh(), increasing.
+    /// The MT vertex id of every vertex of active_mesh() (increasing after the first
+    /// extraction; local changes renumber vertices into freed slots).
     const std::vector<std::uint32_t> &
     active_vertices() const
     {
       return vertices;
     }
-
-    /**
-     * Fills positions @p x and velocities @p v (3 per vertex of active_mesh()) from the
-     * state @p old_x, @p old_v of the previous level of detail, whose vertices were
-     * @p old_vertices: vertices kept keep their state, new ones get the state
-     * interpolated in the previous level's tetrahedron that contains them
-     * (Lod::locate_in_previous), with barycentric coordinates clamped to the
-     * tetrahedron.
-     */
-    void
-    transfer_state(const std::vector<std::uint32_t> &old_vertices,
-                   const std::vector<double>        &old_x,
-                   const std::vector<double>        &old_v,
-                   std::vector<double>              &x,
-                   std::vector<double>              &v);
 
     /// Writes the MT's size, its build or load and the current level of detail.
     void
@@ -167,9 +180,14 @@ namespace lacerta::mt
     serialize(Archive &archive);
 
   private:
-    /// Rebuilds the mesh and the vertex list from the Lod.
+    /// Rebuilds the mesh and the vertex lists from the Lod.
     void
     make_active_mesh();
+
+    /// The active mesh's tetrahedron with the vertices of MT tetrahedron @p t (an
+    /// internal error if there is none).
+    unsigned int
+    mesh_tet_of(std::uint32_t t) const;
 
     MultiTriangulation                         mt;
     std::unique_ptr<MtCutter>                  mt_cutter;
@@ -187,6 +205,14 @@ namespace lacerta::mt
     unsigned int               last_step = 0;
     mesh::TetMesh              mesh;
     std::vector<std::uint32_t> vertices;
-    std::size_t                n_kept = 0, n_new = 0;
+    /// The active mesh's vertex of every MT vertex, invalid_index if inactive.
+    std::vector<std::uint32_t> mesh_vertex_of;
+    /// Scratch of apply_change().
+    std::vector<std::uint32_t>               mt_removed, mt_added;
+    std::vector<unsigned int>                removed, held, dead;
+    std::vector<mesh::Tet>                   added;
+    std::vector<std::array<unsigned int, 4>> face_ids;
+    std::vector<std::array<unsigned int, 2>> vertex_moves;
+    std::size_t                              n_kept = 0, n_new = 0;
   };
 } // namespace lacerta::mt

@@ -68,6 +68,16 @@ namespace lacerta::scene
     follow_copies(const std::vector<std::array<unsigned int, 2>> &copies,
                   physics::ParticleSystem                        &system);
 
+    /**
+     * Follows particles renumbered into freed slots (@p moves: (to, from) in order,
+     * ParticleSystem::remove_particles()) and initialises the constraint again (a new
+     * level of detail changed the masses). Its particles are never among the removed
+     * ones: the MT never removes a constrained vertex.
+     */
+    void
+    follow_moves(const std::vector<std::array<unsigned int, 2>> &moves,
+                 physics::ParticleSystem                        &system);
+
     /// Whether the constraint prescribes the motion of its particles.
     virtual bool
     prescribes_motion() const = 0;

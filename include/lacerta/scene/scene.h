@@ -22,7 +22,8 @@
 namespace lacerta::physics
 {
   class ParticleSystem;
-}
+  class TopologyUpdate;
+} // namespace lacerta::physics
 namespace lacerta::mt
 {
   class Multiresolution;
@@ -236,14 +237,14 @@ namespace lacerta::scene
     assemble(const mesh::TetMesh &active, double t);
 
     /**
-     * Moves the particle system to the level of detail the MT now holds, at time @p t:
-     * assembles it there, fills its positions and velocities with
-     * @p transfer(old_x, old_v, x, v) from the state it had, enforces the constraints
-     * and refreshes the force model.
+     * Moves the particle system to the level of detail the last extraction chose, at
+     * time @p t, locally (Multiresolution::apply_change() through `level_update`, the
+     * update a cut makes): the mass of the swapped region is kept, the constraints
+     * follow the renumbered particles and are enforced. Returns the particles' moves
+     * (SystemChange::particle_moves).
      */
-    template <typename Transfer>
-    void
-    move_to_level_of_detail(double t, const Transfer &transfer);
+    const std::vector<std::array<unsigned int, 2>> &
+    move_to_level_of_detail(double t);
 
     /// The mesh the cutter cuts: the level of detail's, or the mesh.
     mesh::TetMesh &
@@ -252,8 +253,15 @@ namespace lacerta::scene
     /// The records of the sweeps of the cutter and the lacerator's cutters since the
     /// last MT update (multiresolution).
     std::vector<cut::CutRecord> cut_records;
-    /// Volume of the level of detail when it was last assembled.
+    /// Volume of the level of detail: when it was assembled, then followed through
+    /// every change of level.
     double level_of_detail_volume = 0;
+    /// The factor the level of detail's lumped masses were scaled by when it was
+    /// assembled, so that they sum to ∫σ; later changes of level use it too.
+    double level_mass_scale = 1;
+    /// The local update of the level of detail's mesh and particle system (made at
+    /// the first change of level).
+    std::unique_ptr<physics::TopologyUpdate> level_update;
     /// The parameters of `subsection Cut`, for restart_cutter().
     cut::Cutter::Parameters cutter_parameters;
     bool                    has_varying_loads = false;

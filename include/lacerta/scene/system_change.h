@@ -30,7 +30,7 @@ namespace lacerta::scene
       cut,
       /// A tear cut the mesh locally.
       laceration,
-      /// The system moved to a newly extracted level of detail.
+      /// The system moved locally to a newly extracted level of detail.
       level_of_detail
     };
 
@@ -49,13 +49,13 @@ namespace lacerta::scene
     const std::vector<std::array<unsigned int, 2>> &
     copied_particles() const;
 
-    /// Whether the system was assembled anew on another mesh (every particle and
-    /// spring replaced) rather than changed locally.
-    bool
-    reassembled() const
-    {
-      return cause == Cause::level_of_detail;
-    }
+    /**
+     * A change of the level of detail removes particles: every pair (to, from), in
+     * order, moved particle `from` into the freed slot `to`
+     * (ParticleSystem::remove_particles()). Subscribers that keep particle ids follow
+     * them; nullptr for a cut or a tear, which only add particles.
+     */
+    const std::vector<std::array<unsigned int, 2>> *particle_moves = nullptr;
 
     /// The cause in words, for messages: "the cut", "the laceration", ...
     std::string
