@@ -181,7 +181,7 @@ namespace
     }
     std::vector<std::array<unsigned int, 4>> ids(children.size(), {{0, 0, 0, 0}});
     std::vector<unsigned int>                added;
-    mesh::TetMesh::Update                update;
+    mesh::TetMesh::Update                    update;
     mesh.replace_tets({tet}, children, ids, added, update);
     for (const unsigned int c : added)
       for (unsigned int f = 0; f < 4; ++f)
