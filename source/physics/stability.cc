@@ -817,9 +817,12 @@ namespace lacerta::physics
   {
     check_finite(system, &changed, step, time, " (right after " + cause + ")");
     // New particles enter the work of the loads from where they are now.
+    // Particles removed from the end (a coarser level of detail) leave it; a moved one
+    // takes the slot's entries until the ledger restarts at the next check.
     const std::size_t n = system.position.size();
     for (std::size_t c = previous_position.size(); c < n; ++c)
       previous_position.push_back(system.position[c]);
+    previous_position.resize(n);
     previous_load.resize(n, 0.0);
     load.resize(n, 0.0);
     if (pending_change.empty())

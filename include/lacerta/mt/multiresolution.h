@@ -98,6 +98,13 @@ namespace lacerta::mt
     const std::vector<std::array<unsigned int, 2>> &
     apply_change(physics::TopologyUpdate &topology, physics::ParticleSystem &system);
 
+    /// The cells the last apply_change() removed and added (their sum).
+    std::size_t
+    last_swapped_cells() const
+    {
+      return mt_removed.size() + mt_added.size();
+    }
+
     /// The particles apply_change() added (the last ones of the system).
     unsigned int
     n_new_particles() const
