@@ -2,6 +2,8 @@
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/topology_update.h>
 
+#include <algorithm>
+
 namespace lacerta::physics
 {
   TopologyUpdate::TopologyUpdate(mesh::TetMesh                     &mesh_in,
@@ -19,6 +21,9 @@ namespace lacerta::physics
     if (const auto sigma = constant_value(density))
       constant_density_mass.emplace(*sigma);
     constant_youngs_modulus = constant_value(youngs_modulus);
+    const auto &k           = system.springs.stiffness;
+    if (system.fitted_springs && !k.empty())
+      fitted_floor = 1e-6 * *std::max_element(k.begin(), k.end());
   }
 
 
@@ -59,6 +64,18 @@ namespace lacerta::physics
       (sign > 0 ? put_in : taken_out) += terms.mass[i];
     }
     volume_change += sign * mesh.volume(t);
+    if (system.fitted_springs)
+    {
+      const std::array<double, 6> k =
+        fitted_edge_stiffnesses(mesh, t, youngs_modulus, system.poisson_ratio);
+      for (unsigned int i = 0; i < 6; ++i)
+      {
+        const unsigned int e = mesh.tet_edges(t)[i];
+        springs.stiffness[e] += sign * k[i];
+        changed_springs.push_back(e);
+      }
+      return;
+    }
     const double f = sign * terms.stiffness_factor;
     for (const unsigned int e : mesh.tet_edges(t))
     {
@@ -112,6 +129,12 @@ namespace lacerta::physics
     put_in = 0;
     for (const unsigned int t : added_ids)
       add_cell_terms(t, +1);
+    // Fitted springs keep compute_fitted_springs()'s token stiffness where every cell
+    // of an edge dropped it (and where rounding left a sum a hair below it).
+    if (system.fitted_springs)
+      for (const unsigned int e : changed_springs)
+        if (e < springs.size())
+          springs.stiffness[e] = std::max(springs.stiffness[e], fitted_floor);
     return added_ids;
   }
 

@@ -304,6 +304,7 @@ namespace lacerta::scene
     system->mesh           = &active;
     system->youngs_modulus = &material.youngs_modulus();
     system->poisson_ratio  = material.poisson_ratio;
+    system->fitted_springs = material.fitted_springs;
     for (auto &force : body_forces)
       force->initialize(*system);
     for (auto &constraint : constraints)

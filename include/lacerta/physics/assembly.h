@@ -135,6 +135,17 @@ namespace lacerta::physics
                   const dealii::Function<3, double> &youngs_modulus);
 
   /**
+   * The contributions of tetrahedron @p t to the stiffness of its six edges (local edge
+   * order) under compute_fitted_springs()'s rule: the k ≥ 0 that fit its P1 stiffness
+   * with E at its centroid and Poisson ratio @p poisson_ratio best.
+   */
+  std::array<double, 6>
+  fitted_edge_stiffnesses(const mesh::TetMesh               &mesh,
+                          unsigned int                       t,
+                          const dealii::Function<3, double> &youngs_modulus,
+                          double                             poisson_ratio);
+
+  /**
    * Springs fitted to linear elasticity (beyond the paper; Lloyd, Székely and Harders,
    * IEEE TVCG 2007): tetrahedron τ gives its six edges the stiffnesses k ≥ 0 that
    * minimise the Frobenius norm |K_τ - Σ_e k_e n_e n_eᵀ blocks| between the linear

@@ -78,6 +78,10 @@ namespace lacerta::physics
     const dealii::Function<3, double> *youngs_modulus = nullptr;
     /// The Poisson ratio the force models per tetrahedron reproduce.
     double poisson_ratio = 0.25;
+    /// Whether the springs were fitted per tetrahedron with `poisson_ratio`
+    /// (compute_fitted_springs()) rather than made by Section 3.2's rule: the local
+    /// updates of cuts, tears and levels of detail (TopologyUpdate) follow the same rule.
+    bool fitted_springs = false;
 
     /**
      * Called by the integrators at the end of every (sub)step to put the constrained

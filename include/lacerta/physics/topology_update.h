@@ -19,12 +19,13 @@ namespace lacerta::physics
   /**
    * Replaces tetrahedra of a mesh and follows the change in the particle system whose
    * particles are the mesh's vertices, locally: the cells that go take their lumped
-   * masses (Section 3.1) and their share E·V/|e|² of their edges' springs (Section
-   * 3.2) out, the mesh is changed by TetMesh::replace_tets(), the springs follow the
-   * edges (appended, moved into retired slots), the cells that come put their terms
-   * in, and particles left without cells are removed. The springs changed since the
-   * last notify_force_model() are then passed to the force model at once. The cost is
-   * proportional to the cells and particles involved, never to the mesh.
+   * masses (Section 3.1) and their share of their edges' springs (E·V/|e|², Section
+   * 3.2, or their fitted stiffnesses if ParticleSystem::fitted_springs) out, the mesh is
+   * changed by TetMesh::replace_tets(), the springs follow the edges (appended, moved
+   * into retired slots), the cells that come put their terms in, and particles left
+   * without cells are removed. The springs changed since the last notify_force_model()
+   * are then passed to the force model at once. The cost is proportional to the cells and
+   * particles involved, never to the mesh.
    *
    * A change is made of these stages, in this order: take_out() of the cells that go
    * (while the mesh still has them), any new particles (the caller adds them to both
@@ -154,5 +155,8 @@ namespace lacerta::physics
     double taken_out = 0, put_in = 0;
     /// The lumped masses the particles removed since the last take_out() held (kg).
     double removed_mass = 0;
+    /// With fitted springs: compute_fitted_springs()'s token stiffness, 1e-6 of the
+    /// stiffest spring when the update was made (N/m).
+    double fitted_floor = 0;
   };
 } // namespace lacerta::physics
