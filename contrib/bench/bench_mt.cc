@@ -180,9 +180,8 @@ namespace lacerta::bench
           if (s.reextracted)
           {
             const auto &scene = simulator.get_scene();
-            run.swapped_share +=
-              double(scene.multiresolution->last_swapped_cells())
-              / double(scene.active_mesh().n_tets());
+            run.swapped_share += double(scene.multiresolution->last_swapped_cells())
+                                 / double(scene.active_mesh().n_tets());
           }
         };
         const auto start = Clock::now();
