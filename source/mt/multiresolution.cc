@@ -245,9 +245,7 @@ namespace lacerta::mt
     // MT had, so the list stays increasing.
     const std::size_t          known      = vertices.size();
     const MtCutter::Statistics statistics = mt_cutter->apply(records, vertices, *lod);
-    mesh_vertex_of.resize(mt.n_vertices(), mesh::invalid_index);
-    for (std::size_t i = known; i < vertices.size(); ++i)
-      mesh_vertex_of[vertices[i]] = static_cast<std::uint32_t>(i);
+    index_mesh_vertices(known);
     if (vertices.size() != mesh.n_vertices())
       throw_error("Multiresolution: internal error, the MT knows ",
                   vertices.size(),
@@ -263,8 +261,16 @@ namespace lacerta::mt
   {
     vertices = lod->active_vertices();
     mesh     = lod->make_mesh(vertices, "level of detail");
-    mesh_vertex_of.assign(mt.n_vertices(), mesh::invalid_index);
-    for (std::size_t i = 0; i < vertices.size(); ++i)
+    mesh_vertex_of.clear();
+    index_mesh_vertices(0);
+  }
+
+
+  void
+  Multiresolution::index_mesh_vertices(const std::size_t first)
+  {
+    mesh_vertex_of.resize(mt.n_vertices(), mesh::invalid_index);
+    for (std::size_t i = first; i < vertices.size(); ++i)
       mesh_vertex_of[vertices[i]] = static_cast<std::uint32_t>(i);
   }
 

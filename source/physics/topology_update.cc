@@ -114,12 +114,11 @@ namespace lacerta::physics
                         mesh::distance(mesh.vertex(edges[e][1]),
                                        mesh.vertex(edges[e][0])));
     }
-    for (const auto &[to, from] : update_of_mesh.edge_moves)
+    // The mesh copied its last edge into each retired slot: so do the springs.
+    for (const auto &move : update_of_mesh.edge_moves)
     {
-      // The mesh copied its last edge `from` into slot `to`: so do the springs.
-      (void)from;
-      changed_springs.push_back(to);
-      springs.retire(to);
+      changed_springs.push_back(move[0]);
+      springs.retire(move[0]);
     }
     // A cell moved into a freed slot keeps its particles and springs, but the force
     // model's data by cell must follow it: its edges count as changed.

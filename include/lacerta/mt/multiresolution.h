@@ -105,13 +105,6 @@ namespace lacerta::mt
       return mt_removed.size() + mt_added.size();
     }
 
-    /// The particles apply_change() added (the last ones of the system).
-    unsigned int
-    n_new_particles() const
-    {
-      return static_cast<unsigned int>(n_new);
-    }
-
     /// The mesh of the current level of detail (vertices numbered compactly).
     const mesh::TetMesh &
     active_mesh() const
@@ -190,6 +183,10 @@ namespace lacerta::mt
     /// Rebuilds the mesh and the vertex lists from the Lod.
     void
     make_active_mesh();
+
+    /// Enters the mesh vertices from @p first on into `mesh_vertex_of`.
+    void
+    index_mesh_vertices(std::size_t first);
 
     /// The active mesh's tetrahedron with the vertices of MT tetrahedron @p t (an
     /// internal error if there is none).

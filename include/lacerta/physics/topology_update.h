@@ -46,18 +46,6 @@ namespace lacerta::physics
                    const dealii::Function<3, double> &youngs_modulus,
                    double                             mass_scale = 1.0);
 
-    /// A cell's lumped mass contributions (Section 3.1) and its stiffness factor E·V
-    /// (Section 3.2).
-    struct CellTerms
-    {
-      std::array<double, 4> mass;
-      double                stiffness_factor;
-    };
-
-    /// The terms of cell @p t of the mesh as it is now.
-    CellTerms
-    cell_terms(unsigned int t) const;
-
     /// Takes the terms of the cells @p removed out of their particles' masses and
     /// their edges' springs (before replace() removes them).
     void
@@ -97,13 +85,6 @@ namespace lacerta::physics
     void
     notify_force_model();
 
-    /// What the last replace() did to the mesh's ids.
-    const mesh::TetMesh::Update &
-    mesh_update() const
-    {
-      return update_of_mesh;
-    }
-
     /// The particles whose masses take_out() and replace() changed since
     /// clear_touched(), with repetitions.
     const std::vector<unsigned int> &
@@ -135,6 +116,18 @@ namespace lacerta::physics
     }
 
   private:
+    /// A cell's lumped mass contributions (Section 3.1) and its stiffness factor E·V
+    /// (Section 3.2).
+    struct CellTerms
+    {
+      std::array<double, 4> mass;
+      double                stiffness_factor;
+    };
+
+    /// The terms of cell @p t of the mesh as it is now.
+    CellTerms
+    cell_terms(unsigned int t) const;
+
     /// Adds @p sign (+1 or -1) times cell @p t's terms to its particles' masses and
     /// its edges' springs.
     void
