@@ -1,5 +1,6 @@
 #include <lacerta/base/exceptions.h>
 #include <lacerta/physics/assembly.h>
+#include <lacerta/physics/spring_fit.h>
 
 #include <deal.II/base/function.h>
 #include <deal.II/base/quadrature_lib.h>
@@ -313,6 +314,43 @@ namespace lacerta::physics
 
 
   std::array<double, 6>
+  paper_edge_stiffnesses(const std::array<mesh::Point3, 4> &x,
+                         const double                       youngs_modulus)
+  {
+    const double e_times_v = youngs_modulus * mesh::signed_volume(x[0], x[1], x[2], x[3]);
+    std::array<double, 6> k{};
+    for (unsigned int i = 0; i < 6; ++i)
+    {
+      const auto [a, b]    = mesh::TetMesh::edge_vertices[i];
+      const mesh::Point3 d = mesh::sub(x[b], x[a]);
+      k[i]                 = e_times_v / mesh::dot(d, d);
+    }
+    return k;
+  }
+
+
+  std::array<double, 6>
+  fitted_edge_stiffnesses(const std::array<mesh::Point3, 4> &x,
+                          const double                       youngs_modulus,
+                          const double                       poisson_ratio)
+  {
+    const auto [lambda, mu]    = lame_parameters(youngs_modulus, poisson_ratio);
+    const auto          target = p1_element_stiffness(x, lambda, mu);
+    std::vector<double> entries(144);
+    for (unsigned int r = 0; r < 12; ++r)
+      for (unsigned int c = 0; c < 12; ++c)
+        entries[12 * r + c] = target(r, c);
+    const std::vector<mesh::Point3>                points(x.begin(), x.end());
+    const std::vector<std::array<unsigned int, 2>> edges(
+      mesh::TetMesh::edge_vertices.begin(), mesh::TetMesh::edge_vertices.end());
+    const std::vector<double> fit = fit_spring_stiffnesses(points, edges, entries);
+    std::array<double, 6>     k{};
+    std::copy(fit.begin(), fit.end(), k.begin());
+    return k;
+  }
+
+
+  std::array<double, 6>
   fitted_edge_stiffnesses(const mesh::TetMesh               &mesh,
                           const unsigned int                 t,
                           const dealii::Function<3, double> &youngs_modulus,
@@ -321,70 +359,25 @@ namespace lacerta::physics
     std::array<mesh::Point3, 4> x;
     for (unsigned int i = 0; i < 4; ++i)
       x[i] = mesh.vertex(mesh.tet(t)[i]);
-    const double E          = youngs_modulus.value(centroid_of(mesh, t));
-    const auto [lambda, mu] = lame_parameters(E, poisson_ratio);
-    const auto target       = p1_element_stiffness(x, lambda, mu);
-    // The stiffness of a unit spring on each local edge: k n nᵀ blocks.
-    std::array<dealii::FullMatrix<double>, 6> unit;
-    for (unsigned int e = 0; e < 6; ++e)
-    {
-      const auto [a, b] = mesh::TetMesh::edge_vertices[e];
-      dealii::Tensor<1, 3> n;
-      for (unsigned int d = 0; d < 3; ++d)
-        n[d] = x[b][d] - x[a][d];
-      n /= n.norm();
-      unit[e].reinit(12, 12);
-      for (unsigned int c = 0; c < 3; ++c)
-        for (unsigned int d = 0; d < 3; ++d)
-        {
-          const double v                = n[c] * n[d];
-          unit[e](3 * a + c, 3 * a + d) = unit[e](3 * b + c, 3 * b + d) = v;
-          unit[e](3 * a + c, 3 * b + d) = unit[e](3 * b + c, 3 * a + d) = -v;
-        }
-    }
-    // Least squares in the Frobenius norm, min |K_e - Σ k_i S_i|, over k >= 0: the
-    // normal equations on the edges still active; an edge whose stiffness comes out
-    // negative (a spring cannot push back in tension) is dropped and the rest refit.
-    std::array<bool, 6>   active{true, true, true, true, true, true};
-    std::array<double, 6> k{};
-    for (unsigned int pass = 0; pass < 6; ++pass)
-    {
-      std::vector<unsigned int> index;
-      for (unsigned int e = 0; e < 6; ++e)
-        if (active[e])
-          index.push_back(e);
-      const unsigned int         m = index.size();
-      dealii::FullMatrix<double> normal(m, m);
-      dealii::Vector<double>     rhs(m), solution(m);
-      for (unsigned int i = 0; i < m; ++i)
-      {
-        for (unsigned int j = 0; j < m; ++j)
-          for (unsigned int r = 0; r < 12; ++r)
-            for (unsigned int c = 0; c < 12; ++c)
-              normal(i, j) += unit[index[i]](r, c) * unit[index[j]](r, c);
-        for (unsigned int r = 0; r < 12; ++r)
-          for (unsigned int c = 0; c < 12; ++c)
-            rhs(i) += unit[index[i]](r, c) * target(r, c);
-      }
-      normal.gauss_jordan();
-      normal.vmult(solution, rhs);
-      k.fill(0.0);
-      bool all_positive = true;
-      for (unsigned int i = 0; i < m; ++i)
-      {
-        k[index[i]] = solution(i);
-        if (solution(i) < 0)
-        {
-          active[index[i]] = false;
-          all_positive     = false;
-        }
-      }
-      if (all_positive)
-        break;
-      for (double &value : k)
-        value = std::max(value, 0.0);
-    }
-    return k;
+    return fitted_edge_stiffnesses(x,
+                                   youngs_modulus.value(centroid_of(mesh, t)),
+                                   poisson_ratio);
+  }
+
+
+  SpringSet
+  compute_springs(const mesh::TetMesh                      &mesh,
+                  const std::vector<std::array<double, 6>> &cell_stiffness)
+  {
+    SpringSet springs =
+      springs_from_contributions(mesh,
+                                 [&](const unsigned int t, const std::vector<double> &)
+                                 { return cell_stiffness[t]; });
+    const double floor =
+      1e-6 * *std::max_element(springs.stiffness.begin(), springs.stiffness.end());
+    for (double &k : springs.stiffness)
+      k = std::max(k, floor);
+    return springs;
   }
 
 

@@ -1,5 +1,6 @@
 // Masses (Section 3.1) and spring stiffnesses (Section 3.2).
 
+#include <lacerta/physics/spring_fit.h>
 #include <lacerta/scene/material.h>
 
 #include <deal.II/base/function_parser.h>
@@ -160,5 +161,55 @@ TEST(Assembly, StiffnessSumsOverTheTetrahedraAroundAnEdge)
     const bool         in1 = a >= 1 && b >= 1;
     const double       l2  = springs.rest_length[s] * springs.rest_length[s];
     EXPECT_NEAR(springs.stiffness[s], ((in0 ? v0 : 0) + (in1 ? v1 : 0)) / l2, 1e-14);
+  }
+}
+
+
+TEST(Assembly, SpringFitRecoversSpringsThatRepresentTheTarget)
+{
+  // Five points, nine edges, known stiffnesses (one zero): their linearised stiffness
+  // is the target, so the fit must give them back; a negative one cannot be a spring.
+  const std::vector<mesh::Point3> x = {
+    {{0, 0, 0}}, {{1, 0.1, 0}}, {{0.2, 1, 0.1}}, {{0.1, 0.3, 1.2}}, {{1, 1, 1}}};
+  const std::vector<std::array<unsigned int, 2>> edges = {{{0, 1}},
+                                                          {{0, 2}},
+                                                          {{0, 3}},
+                                                          {{1, 2}},
+                                                          {{1, 3}},
+                                                          {{2, 3}},
+                                                          {{1, 4}},
+                                                          {{2, 4}},
+                                                          {{3, 4}}};
+  for (const bool with_negative : {false, true})
+  {
+    std::vector<double> k = {3, 1, 0, 2.5, 0.7, 4, 1.5, 2, 0.3};
+    if (with_negative)
+      k[4] = -0.5;
+    std::vector<double> target(9 * x.size() * x.size(), 0.0);
+    const std::size_t   n3 = 3 * x.size();
+    for (std::size_t e = 0; e < edges.size(); ++e)
+    {
+      const auto [a, b]    = edges[e];
+      const mesh::Point3 d = mesh::sub(x[b], x[a]);
+      for (unsigned int r = 0; r < 3; ++r)
+        for (unsigned int c = 0; c < 3; ++c)
+        {
+          const double v = k[e] * d[r] * d[c] / mesh::dot(d, d);
+          target[(3 * a + r) * n3 + 3 * a + c] += v;
+          target[(3 * b + r) * n3 + 3 * b + c] += v;
+          target[(3 * a + r) * n3 + 3 * b + c] -= v;
+          target[(3 * b + r) * n3 + 3 * a + c] -= v;
+        }
+    }
+    const std::vector<double> fit = physics::fit_spring_stiffnesses(x, edges, target);
+    ASSERT_EQ(fit.size(), edges.size());
+    for (std::size_t e = 0; e < edges.size(); ++e)
+    {
+      EXPECT_GE(fit[e], 0.0);
+      if (!with_negative)
+        EXPECT_NEAR(fit[e], k[e], 1e-12) << "edge " << e;
+    }
+    if (with_negative)
+      EXPECT_EQ(fit[4], 0.0);
   }
 }

@@ -135,6 +135,33 @@ namespace lacerta::physics
                   const dealii::Function<3, double> &youngs_modulus);
 
   /**
+   * The springs of @p mesh whose cells contribute @p cell_stiffness (per cell, its six
+   * edges in local order) to their edges' stiffnesses; an edge no cell gives anything
+   * keeps a token 1e-6 of the stiffest spring, as compute_fitted_springs() does.
+   */
+  SpringSet
+  compute_springs(const mesh::TetMesh                      &mesh,
+                  const std::vector<std::array<double, 6>> &cell_stiffness);
+
+  /**
+   * The contributions E V / |e|² of a tetrahedron with rest vertices @p x (positively
+   * oriented) and Young's modulus @p youngs_modulus to its six edges' stiffnesses
+   * (local order mesh::TetMesh::edge_vertices; Section 3.2).
+   */
+  std::array<double, 6>
+  paper_edge_stiffnesses(const std::array<mesh::Point3, 4> &x, double youngs_modulus);
+
+  /**
+   * The contributions of a tetrahedron with rest vertices @p x to its six edges'
+   * stiffnesses (local edge order) under compute_fitted_springs()'s rule, with Young's
+   * modulus @p youngs_modulus and Poisson ratio @p poisson_ratio.
+   */
+  std::array<double, 6>
+  fitted_edge_stiffnesses(const std::array<mesh::Point3, 4> &x,
+                          double                             youngs_modulus,
+                          double                             poisson_ratio);
+
+  /**
    * The contributions of tetrahedron @p t to the stiffness of its six edges (local edge
    * order) under compute_fitted_springs()'s rule: the k ≥ 0 that fit its P1 stiffness
    * with E at its centroid and Poisson ratio @p poisson_ratio best.
