@@ -16,7 +16,7 @@ namespace lacerta
   {
     /// The first bytes of every checkpoint, and the version of the state's layout.
     constexpr std::string_view magic          = "LACERTA CHECKPOINT\n";
-    constexpr std::uint32_t    format_version = 6;
+    constexpr std::uint32_t    format_version = 7;
     constexpr std::size_t      header_bytes =
       magic.size() + sizeof(std::uint32_t) + 2 * sizeof(std::uint64_t);
 

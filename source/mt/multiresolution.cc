@@ -3,6 +3,7 @@
 #include <lacerta/base/parameter_utilities.h>
 #include <lacerta/base/parsed_function.h>
 #include <lacerta/cut/tool.h>
+#include <lacerta/mt/coarse_stiffness.h>
 #include <lacerta/mt/multiresolution.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/topology_update.h>
@@ -54,6 +55,17 @@ namespace lacerta::mt
                       "50",
                       dealii::Patterns::Integer(1, 100000000),
                       "... or when this many steps have passed since the last one.");
+    prm.declare_entry(
+      "Coarse stiffness",
+      "rule",
+      dealii::Patterns::Selection("rule|condensed"),
+      "The springs of the decimated cells. rule: the rule of 'Material/Spring "
+      "stiffness' applied to the coarse cells as to any mesh. condensed: the rule's "
+      "springs scaled per edge so that each coarse fragment's energies under uniform "
+      "strains are those of the fine cells it replaced with the removed vertex "
+      "condensed out; measured to make the level of detail softer than the full "
+      "mesh, not closer to it (doc/multiresolution.md, 'The material of a level of "
+      "detail').");
     LodQueryRegistry::declare_selector(prm,
                                        "Query",
                                        "focus",
@@ -62,10 +74,13 @@ namespace lacerta::mt
     prm.enter_subsection("Builder");
     prm.declare_entry(
       "Minimum quality",
-      "0.1",
+      "0.3",
       dealii::Patterns::Double(0.001, 0.9),
       "No decimation step may create a tetrahedron of lower mean-ratio "
-      "quality 12 (3V)^(2/3) / sum of squared edges (1 regular, 0 flat).");
+      "quality 12 (3V)^(2/3) / sum of squared edges (1 regular, 0 flat). Springs "
+      "on flat tetrahedra make a softer material than the fine mesh they stand "
+      "for: at 0.1 the first level of detail's static error is up to twice that "
+      "at 0.3 (doc/multiresolution.md).");
     prm.declare_entry(
       "Maximum boundary error",
       "0.01",
@@ -107,9 +122,10 @@ namespace lacerta::mt
       throw_error(
         "Multiresolution/Focus follows = tool: the scene has no tool to follow; set "
         "'Tool/Type' to a tool or 'Focus follows = path'.");
-    distance = prm.get_double("Re-extraction distance");
-    interval = prm.get_integer("Re-extraction interval");
-    query    = LodQueryRegistry::create_and_parse(prm.get("Query"), prm);
+    distance  = prm.get_double("Re-extraction distance");
+    interval  = prm.get_integer("Re-extraction interval");
+    condenses = prm.get("Coarse stiffness") == "condensed";
+    query     = LodQueryRegistry::create_and_parse(prm.get("Query"), prm);
     BuilderParameters parameters;
     prm.enter_subsection("Builder");
     parameters.minimum_quality        = prm.get_double("Minimum quality");
@@ -257,6 +273,84 @@ namespace lacerta::mt
 
 
   void
+  Multiresolution::set_stiffness_rule(const EdgeStiffnessRule &rule_in)
+  {
+    rule = rule_in;
+    if (condenses)
+      condensed = condensed_edge_stiffnesses(mt, rule);
+  }
+
+
+  std::array<double, 6>
+  Multiresolution::edge_stiffnesses(const std::uint32_t t, const mesh::Tet &cell) const
+  {
+    std::array<mesh::Point3, 4> x;
+    for (unsigned int i = 0; i < 4; ++i)
+      x[i] = mesh.vertex(cell[i]);
+    // Tetrahedra cuts created after the condensation take the rule.
+    if (t >= condensed.size())
+      return rule(x);
+    // The MT stores t with its own vertex order: find the cell's edges in it.
+    std::array<unsigned int, 4> position{};
+    for (unsigned int i = 0; i < 4; ++i)
+    {
+      const auto at = std::find(mt.tets[t].begin(), mt.tets[t].end(), vertices[cell[i]]);
+      if (at == mt.tets[t].end())
+        throw_error("Multiresolution: internal error, a cell is not MT tetrahedron ",
+                    t,
+                    ".");
+      position[i] = static_cast<unsigned int>(at - mt.tets[t].begin());
+    }
+    std::array<double, 6> k{};
+    for (unsigned int e = 0; e < 6; ++e)
+    {
+      const auto [a, b] = mesh::TetMesh::edge_vertices[e];
+      for (unsigned int f = 0; f < 6; ++f)
+      {
+        const auto [c, d] = mesh::TetMesh::edge_vertices[f];
+        if ((c == position[a] && d == position[b])
+            || (c == position[b] && d == position[a]))
+          k[e] = condensed[t][f];
+      }
+    }
+    return k;
+  }
+
+
+  std::vector<std::array<double, 6>>
+  Multiresolution::active_cell_stiffnesses() const
+  {
+    // The MT tetrahedron of every active cell, by its sorted MT vertices.
+    using Key = std::array<std::uint32_t, 4>;
+    std::vector<std::pair<Key, std::uint32_t>> by_vertices;
+    for (const std::uint32_t t : lod->active_tets())
+    {
+      Key key = mt.tets[t];
+      std::sort(key.begin(), key.end());
+      by_vertices.emplace_back(key, t);
+    }
+    std::sort(by_vertices.begin(), by_vertices.end());
+    std::vector<std::array<double, 6>> k(mesh.n_tets());
+    for (unsigned int c = 0; c < mesh.n_tets(); ++c)
+    {
+      Key key;
+      for (unsigned int i = 0; i < 4; ++i)
+        key[i] = vertices[mesh.tet(c)[i]];
+      std::sort(key.begin(), key.end());
+      const auto at = std::lower_bound(by_vertices.begin(),
+                                       by_vertices.end(),
+                                       std::make_pair(key, std::uint32_t(0)));
+      if (at == by_vertices.end() || at->first != key)
+        throw_error("Multiresolution: internal error, active cell ",
+                    c,
+                    " is no active MT tetrahedron.");
+      k[c] = edge_stiffnesses(at->second, mesh.tet(c));
+    }
+    return k;
+  }
+
+
+  void
   Multiresolution::make_active_mesh()
   {
     vertices = lod->active_vertices();
@@ -352,7 +446,11 @@ namespace lacerta::mt
     // The boundary faces of a level of detail carry no id (as make_mesh() gives them).
     face_ids.assign(added.size(), {{0, 0, 0, 0}});
     topology.take_out(removed);
-    topology.replace(removed, added, face_ids);
+    added_stiffness.clear();
+    if (condenses)
+      for (std::size_t i = 0; i < added.size(); ++i)
+        added_stiffness.push_back(edge_stiffnesses(mt_added[i], added[i]));
+    topology.replace(removed, added, face_ids, condenses ? &added_stiffness : nullptr);
     // The vertices only the cells that went held.
     dead.clear();
     for (const unsigned int w : held)

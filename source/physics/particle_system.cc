@@ -235,6 +235,7 @@ namespace lacerta::physics
     archive.section("particle system");
     archive(position, velocity, mass, mass_shift, free, external_force, springs);
     archive(body_acceleration, mass_damping, spring_damping, poisson_ratio, rest);
+    archive(cell_stiffness);
     archive(force_threads, changed, listed, all_changed);
     archive.section("force model");
     forces->serialize(archive);

@@ -22,7 +22,7 @@ namespace lacerta::physics
       constant_density_mass.emplace(*sigma);
     constant_youngs_modulus = constant_value(youngs_modulus);
     const auto &k           = system.springs.stiffness;
-    if (system.fitted_springs && !k.empty())
+    if ((system.fitted_springs || !system.cell_stiffness.empty()) && !k.empty())
       fitted_floor = 1e-6 * *std::max_element(k.begin(), k.end());
   }
 
@@ -50,8 +50,25 @@ namespace lacerta::physics
   }
 
 
+  std::array<double, 6>
+  TopologyUpdate::rule_stiffnesses(const unsigned int t, const CellTerms &terms) const
+  {
+    if (system.fitted_springs)
+      return fitted_edge_stiffnesses(mesh, t, youngs_modulus, system.poisson_ratio);
+    std::array<double, 6> k{};
+    for (unsigned int i = 0; i < 6; ++i)
+    {
+      const double length = system.springs.rest_length[mesh.tet_edges(t)[i]];
+      k[i]                = terms.stiffness_factor / (length * length);
+    }
+    return k;
+  }
+
+
   void
-  TopologyUpdate::add_cell_terms(const unsigned int t, const double sign)
+  TopologyUpdate::add_cell_terms(const unsigned int           t,
+                                 const double                 sign,
+                                 const std::array<double, 6> *given)
   {
     SpringSet       &springs = system.springs;
     const CellTerms  terms   = cell_terms(t);
@@ -64,22 +81,19 @@ namespace lacerta::physics
       (sign > 0 ? put_in : taken_out) += terms.mass[i];
     }
     volume_change += sign * mesh.volume(t);
-    if (system.fitted_springs)
+    std::array<double, 6> k;
+    if (!system.cell_stiffness.empty())
     {
-      const std::array<double, 6> k =
-        fitted_edge_stiffnesses(mesh, t, youngs_modulus, system.poisson_ratio);
-      for (unsigned int i = 0; i < 6; ++i)
-      {
-        const unsigned int e = mesh.tet_edges(t)[i];
-        springs.stiffness[e] += sign * k[i];
-        changed_springs.push_back(e);
-      }
-      return;
+      if (sign > 0)
+        system.cell_stiffness[t] = given ? *given : rule_stiffnesses(t, terms);
+      k = system.cell_stiffness[t];
     }
-    const double f = sign * terms.stiffness_factor;
-    for (const unsigned int e : mesh.tet_edges(t))
+    else
+      k = rule_stiffnesses(t, terms);
+    for (unsigned int i = 0; i < 6; ++i)
     {
-      springs.stiffness[e] += f / (springs.rest_length[e] * springs.rest_length[e]);
+      const unsigned int e = mesh.tet_edges(t)[i];
+      springs.stiffness[e] += sign * k[i];
       changed_springs.push_back(e);
     }
   }
@@ -91,16 +105,25 @@ namespace lacerta::physics
     taken_out    = 0;
     removed_mass = 0;
     for (const unsigned int t : removed)
-      add_cell_terms(t, -1);
+      add_cell_terms(t, -1, nullptr);
   }
 
 
   const std::vector<unsigned int> &
   TopologyUpdate::replace(const std::vector<unsigned int>                &removed,
                           const std::vector<mesh::Tet>                   &added,
-                          const std::vector<std::array<unsigned int, 4>> &face_ids)
+                          const std::vector<std::array<unsigned int, 4>> &face_ids,
+                          const std::vector<std::array<double, 6>>       *added_stiffness)
   {
     mesh.replace_tets(removed, added, face_ids, added_ids, update_of_mesh);
+    // The cells' kept stiffnesses follow the cells moved into freed slots.
+    auto &cell_stiffness = system.cell_stiffness;
+    if (!cell_stiffness.empty())
+    {
+      for (const auto &[to, from] : update_of_mesh.tet_moves)
+        cell_stiffness[to] = cell_stiffness[from];
+      cell_stiffness.resize(mesh.n_tets());
+    }
     // Springs follow the edges: appended, moved into retired slots, restiffened.
     SpringSet  &springs = system.springs;
     const auto &edges   = mesh.get_edges();
@@ -126,11 +149,13 @@ namespace lacerta::physics
       for (const unsigned int e : mesh.tet_edges(move[0]))
         changed_springs.push_back(e);
     put_in = 0;
-    for (const unsigned int t : added_ids)
-      add_cell_terms(t, +1);
-    // Fitted springs keep compute_fitted_springs()'s token stiffness where every cell
-    // of an edge dropped it (and where rounding left a sum a hair below it).
-    if (system.fitted_springs)
+    for (std::size_t i = 0; i < added_ids.size(); ++i)
+      add_cell_terms(added_ids[i],
+                     +1,
+                     added_stiffness ? &(*added_stiffness)[i] : nullptr);
+    // Fitted and kept stiffnesses keep the token stiffness where every cell of an edge
+    // dropped it (and where rounding left a sum a hair below it).
+    if (system.fitted_springs || !cell_stiffness.empty())
       for (const unsigned int e : changed_springs)
         if (e < springs.size())
           springs.stiffness[e] = std::max(springs.stiffness[e], fitted_floor);

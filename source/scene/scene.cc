@@ -67,6 +67,17 @@ namespace lacerta::scene
                                                               mesh,
                                                               locked,
                                                               blade ? &*blade : nullptr);
+      multiresolution->set_stiffness_rule(
+        [this](const std::array<mesh::Point3, 4> &x)
+        {
+          const double E = material.youngs_modulus().value(
+            dealii::Point<3>((x[0][0] + x[1][0] + x[2][0] + x[3][0]) / 4,
+                             (x[0][1] + x[1][1] + x[2][1] + x[3][1]) / 4,
+                             (x[0][2] + x[1][2] + x[2][2] + x[3][2]) / 4));
+          return material.fitted_springs
+                   ? physics::fitted_edge_stiffnesses(x, E, material.poisson_ratio)
+                   : physics::paper_edge_stiffnesses(x, E);
+        });
     }
     system = std::make_unique<physics::ParticleSystem>(std::vector<double>());
     if (multiresolution)
@@ -284,11 +295,18 @@ namespace lacerta::scene
                     system->mass[i],
                     " kg; the density must be positive and finite on the object.");
 
-    system->springs = material.fitted_springs
-                        ? physics::compute_fitted_springs(active,
-                                                          material.youngs_modulus(),
-                                                          material.poisson_ratio)
-                        : physics::compute_springs(active, material.youngs_modulus());
+    system->cell_stiffness.clear();
+    if (&active != &mesh && multiresolution->condenses_stiffness())
+    {
+      system->cell_stiffness = multiresolution->active_cell_stiffnesses();
+      system->springs        = physics::compute_springs(active, system->cell_stiffness);
+    }
+    else
+      system->springs = material.fitted_springs
+                          ? physics::compute_fitted_springs(active,
+                                                            material.youngs_modulus(),
+                                                            material.poisson_ratio)
+                          : physics::compute_springs(active, material.youngs_modulus());
     for (std::size_t s = 0; s < system->springs.size(); ++s)
       if (!(system->springs.stiffness[s] > 0)
           || !std::isfinite(system->springs.stiffness[s]))

@@ -1,6 +1,7 @@
 // The Multi-Triangulation: builder, extraction, state transfer and storage invariants.
 
 #include <lacerta/mt/builder.h>
+#include <lacerta/mt/coarse_stiffness.h>
 #include <lacerta/mt/lod.h>
 #include <lacerta/mt/lod_query.h>
 #include <lacerta/mt/storage.h>
@@ -528,5 +529,41 @@ namespace lacerta
     const auto                      mt = mt::build_multi_triangulation(box(), {}, locked);
     for (const unsigned int v : locked)
       EXPECT_EQ(mt.vertex_node[v], 0u);
+  }
+} // namespace lacerta
+
+
+namespace lacerta
+{
+  TEST(MultiTriangulation, CondensedStiffnessKeepsTheInputCellsAndIsNonNegative)
+  {
+    const auto &mt   = box_mt();
+    const auto  rule = [](const std::array<mesh::Point3, 4> &x)
+    { return physics::paper_edge_stiffnesses(x, 1e4); };
+    const auto k = mt::condensed_edge_stiffnesses(mt, rule);
+    ASSERT_EQ(k.size(), mt.n_tets());
+    double total_input = 0, total_root = 0;
+    for (unsigned int t = 0; t < mt.n_tets(); ++t)
+    {
+      std::array<mesh::Point3, 4> x;
+      for (unsigned int i = 0; i < 4; ++i)
+        x[i] = mt.vertices[mt.tets[t][i]];
+      const auto expected = rule(x);
+      for (unsigned int e = 0; e < 6; ++e)
+      {
+        ASSERT_TRUE(std::isfinite(k[t][e])) << "tet " << t;
+        EXPECT_GE(k[t][e], 0.0) << "tet " << t;
+        if (mt.destroyer[t] == mesh::invalid_index)
+        {
+          EXPECT_EQ(k[t][e], expected[e]) << "input tet " << t;
+          total_input += k[t][e];
+        }
+        if (mt.creator[t] == 0)
+          total_root += k[t][e];
+      }
+    }
+    // The root carries stiffness: nothing was condensed to nothing.
+    EXPECT_GT(total_root, 0.0);
+    EXPECT_GT(total_input, 0.0);
   }
 } // namespace lacerta

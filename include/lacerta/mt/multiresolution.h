@@ -8,6 +8,7 @@
 #include <lacerta/cut/cut_record.h>
 #include <lacerta/cut/geometry.h>
 #include <lacerta/mesh/tet_mesh.h>
+#include <lacerta/mt/coarse_stiffness.h>
 #include <lacerta/mt/lod.h>
 #include <lacerta/mt/lod_query.h>
 #include <lacerta/mt/mt_cutter.h>
@@ -141,6 +142,34 @@ namespace lacerta::mt
       return vertices;
     }
 
+    /**
+     * Sets the spring rule of the scene's material (Section 3.2's, or fitted springs)
+     * and, with `Coarse stiffness = condensed`, condenses every coarse fragment's
+     * stiffness from the fine mesh (condensed_edge_stiffnesses()).
+     */
+    void
+    set_stiffness_rule(const EdgeStiffnessRule &rule);
+
+    /// Whether the coarse cells take condensed stiffnesses (`Coarse stiffness =
+    /// condensed`) rather than the rule.
+    bool
+    condenses_stiffness() const
+    {
+      return condenses;
+    }
+
+    /**
+     * The contributions to its six edges' stiffnesses (local edge order) of the
+     * active mesh's cell @p cell (particle ids) that is MT tetrahedron @p t: condensed,
+     * or the rule for tetrahedra a cut made.
+     */
+    std::array<double, 6>
+    edge_stiffnesses(std::uint32_t t, const mesh::Tet &cell) const;
+
+    /// edge_stiffnesses() of every cell of active_mesh().
+    std::vector<std::array<double, 6>>
+    active_cell_stiffnesses() const;
+
     /// Writes the MT's size, its build or load and the current level of detail.
     void
     print_summary(std::ostream &out, bool test_mode) const;
@@ -199,6 +228,13 @@ namespace lacerta::mt
     std::unique_ptr<Lod>                       lod;
     std::unique_ptr<LodQuery>                  query;
     std::unique_ptr<dealii::FunctionParser<3>> path;
+    /// `Coarse stiffness = condensed`.
+    bool condenses = false;
+    /// The material's spring rule (set_stiffness_rule()).
+    EdgeStiffnessRule rule;
+    /// Per MT tetrahedron, its edges' condensed stiffness contributions (empty with
+    /// `Coarse stiffness = rule`).
+    std::vector<std::array<double, 6>> condensed;
     /// `Focus follows = tool`: the focus follows the blade, not the path.
     bool follows_tool = false;
     /// The bounding box of the mesh at rest.
@@ -215,6 +251,7 @@ namespace lacerta::mt
     std::vector<std::uint32_t>               mt_removed, mt_added;
     std::vector<unsigned int>                removed, held, dead;
     std::vector<mesh::Tet>                   added;
+    std::vector<std::array<double, 6>>       added_stiffness;
     std::vector<std::array<unsigned int, 4>> face_ids;
     std::vector<std::array<unsigned int, 2>> vertex_moves;
     std::size_t                              n_kept = 0, n_new = 0;

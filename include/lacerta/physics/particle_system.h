@@ -82,6 +82,13 @@ namespace lacerta::physics
     /// (compute_fitted_springs()) rather than made by Section 3.2's rule: the local
     /// updates of cuts, tears and levels of detail (TopologyUpdate) follow the same rule.
     bool fitted_springs = false;
+    /**
+     * Per cell of `mesh`: its contributions to its six edges' stiffnesses (local edge
+     * order), when they do not come from a rule applied to the cell's own shape (the
+     * condensed stiffness of a level of detail, doc/multiresolution.md); empty when
+     * they do. TopologyUpdate keeps it along the cells.
+     */
+    std::vector<std::array<double, 6>> cell_stiffness;
 
     /**
      * Called by the integrators at the end of every (sub)step to put the constrained

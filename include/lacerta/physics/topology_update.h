@@ -54,12 +54,16 @@ namespace lacerta::physics
     /**
      * Replaces the cells @p removed by @p added in the mesh (TetMesh::replace_tets(),
      * with boundary ids @p face_ids), makes the springs follow the edges and puts the
-     * new cells' terms in. Returns the new cells' ids.
+     * new cells' terms in. Returns the new cells' ids. Where the system keeps its
+     * cells' stiffnesses (ParticleSystem::cell_stiffness), @p added_stiffness, if
+     * given, holds those of the added cells (local edge order); otherwise they follow
+     * the rule.
      */
     const std::vector<unsigned int> &
     replace(const std::vector<unsigned int>                &removed,
             const std::vector<mesh::Tet>                   &added,
-            const std::vector<std::array<unsigned int, 4>> &face_ids);
+            const std::vector<std::array<unsigned int, 4>> &face_ids,
+            const std::vector<std::array<double, 6>>       *added_stiffness = nullptr);
 
     /**
      * Scales the masses the last replace() put in so that they equal those the last
@@ -128,10 +132,17 @@ namespace lacerta::physics
     CellTerms
     cell_terms(unsigned int t) const;
 
-    /// Adds @p sign (+1 or -1) times cell @p t's terms to its particles' masses and
-    /// its edges' springs.
+    /**
+     * Adds @p sign (+1 or -1) times cell @p t's terms to its particles' masses and
+     * its edges' springs; where the system keeps its cells' stiffnesses, an added
+     * cell takes @p given (the rule if null) and keeps it there.
+     */
     void
-    add_cell_terms(unsigned int t, double sign);
+    add_cell_terms(unsigned int t, double sign, const std::array<double, 6> *given);
+
+    /// The rule's contributions of cell @p t to its edges' stiffnesses.
+    std::array<double, 6>
+    rule_stiffnesses(unsigned int t, const CellTerms &terms) const;
 
     mesh::TetMesh                           &mesh;
     ParticleSystem                          &system;
@@ -148,8 +159,8 @@ namespace lacerta::physics
     double taken_out = 0, put_in = 0;
     /// The lumped masses the particles removed since the last take_out() held (kg).
     double removed_mass = 0;
-    /// With fitted springs: compute_fitted_springs()'s token stiffness, 1e-6 of the
-    /// stiffest spring when the update was made (N/m).
+    /// With fitted springs or kept cell stiffnesses: the token stiffness of an edge
+    /// every cell dropped, 1e-6 of the stiffest spring when the update was made (N/m).
     double fitted_floor = 0;
   };
 } // namespace lacerta::physics
