@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "mt_test_support.h"
+#include <cmath>
 #include <sstream>
 
 namespace lacerta
@@ -38,13 +39,20 @@ namespace lacerta
 
 
     /// The mean x of the vertices of the level of detail's smallest tetrahedra (a
-    /// tenth of them): where the level of detail is fine.
+    /// tenth of them) away from the fixed edges at x = ±0.05 (whose vertices are
+    /// never decimated): where the focus made the level of detail fine.
     double
     fine_region_x(const mesh::TetMesh &m)
     {
       std::vector<std::pair<double, unsigned int>> by_volume;
       for (unsigned int t = 0; t < m.n_tets(); ++t)
-        by_volume.emplace_back(m.volume(t), t);
+      {
+        bool fixed = false;
+        for (const unsigned int v : m.tet(t))
+          fixed = fixed || std::abs(m.vertex(v)[0]) > 0.0499;
+        if (!fixed)
+          by_volume.emplace_back(m.volume(t), t);
+      }
       std::sort(by_volume.begin(), by_volume.end());
       double       sum = 0;
       unsigned int n   = 0;

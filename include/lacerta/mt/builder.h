@@ -19,9 +19,11 @@ namespace lacerta::mt
     /**
      * No collapse may create a tetrahedron whose mean-ratio quality
      * 12 (3V)^(2/3) / Σ l² (1 for the regular tetrahedron, 0 for a flat one) is below
-     * this; inverted tetrahedra have negative volume and are always rejected.
+     * this; inverted tetrahedra have negative volume and are always rejected. Springs
+     * on flat tetrahedra are a softer material than the fine cells they replace
+     * (doc/multiresolution.md, "The material of a level of detail").
      */
-    double minimum_quality = 0.1;
+    double minimum_quality = 0.3;
     /**
      * Largest approximate Hausdorff distance between the decimated boundary and the
      * input boundary, as a fraction of the diagonal of the bounding box.
