@@ -215,6 +215,10 @@ TEST_F(CheckpointTest, KilledWriterLeavesACompleteCheckpoint)
   unsigned int kills_during_a_write = 0;
   for (unsigned int round = 0; round < 20; ++round)
   {
+    // The last kill's temporary file goes, so that its reappearance shows that the
+    // new writer has started (which takes long under the sanitizers or on a loaded
+    // machine); the kill then comes at a random moment of the next 20 ms.
+    fs::remove(file + ".tmp");
     const pid_t child = ::fork();
     ASSERT_GE(child, 0);
     if (child == 0)
@@ -222,8 +226,10 @@ TEST_F(CheckpointTest, KilledWriterLeavesACompleteCheckpoint)
       for (unsigned int i = 1;; ++i)
         lacerta::write_checkpoint_file(file, payload_of(i));
     }
+    for (unsigned int wait = 0; wait < 20000 && !fs::exists(file + ".tmp"); ++wait)
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
     std::this_thread::sleep_for(
-      std::chrono::microseconds(std::uniform_int_distribution<int>(1000, 60000)(random)));
+      std::chrono::microseconds(std::uniform_int_distribution<int>(0, 20000)(random)));
     ::kill(child, SIGKILL);
     int status = 0;
     ::waitpid(child, &status, 0);
