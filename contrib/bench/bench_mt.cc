@@ -23,6 +23,7 @@
 #include <iostream>
 #include <sstream>
 #include <sys/resource.h>
+#include <unistd.h>
 
 namespace lacerta::bench
 {
@@ -157,8 +158,11 @@ namespace lacerta::bench
       prm.parse_input(extra, "benchmark settings", "", true);
       prm.set("End time", std::to_string(end_time));
       prm.set("Test mode", "true");
+      // One directory per process: benchmarks run side by side must not share it.
       prm.set("Output directory",
-              (std::filesystem::temp_directory_path() / "lacerta-bench-lod").string());
+              (std::filesystem::temp_directory_path()
+               / ("lacerta-bench-lod-" + std::to_string(::getpid())))
+                .string());
       prm.enter_subsection("Postprocess");
       prm.set("List of postprocessors", "");
       prm.leave_subsection();
