@@ -129,6 +129,29 @@ namespace lacerta::mt
     }
 
 
+    /// strain_energy_matrix() of a spring of stiffness @p k on @p edge.
+    std::array<double, 36>
+    edge_strain_energy_matrix(const std::vector<mesh::Point3>   &points,
+                              const std::array<unsigned int, 2> &edge,
+                              const double                       k)
+    {
+      const mesh::Point3 d = mesh::sub(points[edge[1]], points[edge[0]]);
+      // The elongation of the edge under unit strain a, times its length: dᵀ ε_a d / L.
+      std::array<double, 6> s;
+      const double          length2 = mesh::dot(d, d);
+      for (unsigned int a = 0; a < 6; ++a)
+      {
+        const auto [i, j] = strain_axes[a];
+        s[a]              = d[i] * d[j] / std::sqrt(length2);
+      }
+      std::array<double, 36> m;
+      for (unsigned int a = 0; a < 6; ++a)
+        for (unsigned int b = 0; b < 6; ++b)
+          m[6 * a + b] = k * s[a] * s[b];
+      return m;
+    }
+
+
     /// strain_energy_matrix() of springs of stiffness @p k on @p edges.
     std::array<double, 36>
     spring_strain_energy_matrix(const std::vector<mesh::Point3>                &points,
@@ -138,21 +161,14 @@ namespace lacerta::mt
       std::array<double, 36> m{};
       for (std::size_t e = 0; e < edges.size(); ++e)
       {
-        const mesh::Point3 d = mesh::sub(points[edges[e][1]], points[edges[e][0]]);
-        // The elongation of edge e under unit strain a, times its length: dᵀ ε_a d / L.
-        std::array<double, 6> s;
-        const double          length2 = mesh::dot(d, d);
-        for (unsigned int a = 0; a < 6; ++a)
-        {
-          const auto [i, j] = strain_axes[a];
-          s[a]              = d[i] * d[j] / std::sqrt(length2);
-        }
-        for (unsigned int a = 0; a < 6; ++a)
-          for (unsigned int b = 0; b < 6; ++b)
-            m[6 * a + b] += k[e] * s[a] * s[b];
+        const std::array<double, 36> one =
+          edge_strain_energy_matrix(points, edges[e], k[e]);
+        for (unsigned int i = 0; i < 36; ++i)
+          m[i] += one[i];
       }
       return m;
     }
+
 
     /**
      * Per edge, the factor x_e ≥ floor on the scaled rule's stiffness factor k_e that
@@ -170,11 +186,7 @@ namespace lacerta::mt
       const std::size_t                   m = edges.size();
       std::vector<std::array<double, 36>> unit(m);
       for (std::size_t e = 0; e < m; ++e)
-      {
-        std::vector<double> one(m, 0.0);
-        one[e]  = factor * rule_k[e];
-        unit[e] = spring_strain_energy_matrix(points, edges, one);
-      }
+        unit[e] = edge_strain_energy_matrix(points, edges[e], factor * rule_k[e]);
       std::vector<double> gram(m * m, 0.0), rhs(m, 0.0);
       double              trace = 0;
       for (std::size_t a = 0; a < m; ++a)
