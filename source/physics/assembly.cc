@@ -303,13 +303,23 @@ namespace lacerta::physics
       mesh,
       [&](const unsigned int t, const std::vector<double> &length)
       {
-        const double          e_times_v = tet_stiffness_factor(mesh, t, youngs_modulus);
-        std::array<double, 6> k{};
+        std::array<double, 6> squared_length;
         for (unsigned int i = 0; i < 6; ++i)
-          k[i] =
-            e_times_v / (length[mesh.tet_edges(t)[i]] * length[mesh.tet_edges(t)[i]]);
-        return k;
+          squared_length[i] = length[mesh.tet_edges(t)[i]] * length[mesh.tet_edges(t)[i]];
+        return paper_edge_stiffnesses(tet_stiffness_factor(mesh, t, youngs_modulus),
+                                      squared_length);
       });
+  }
+
+
+  std::array<double, 6>
+  paper_edge_stiffnesses(const double                 e_times_v,
+                         const std::array<double, 6> &squared_length)
+  {
+    std::array<double, 6> k{};
+    for (unsigned int i = 0; i < 6; ++i)
+      k[i] = e_times_v / squared_length[i];
+    return k;
   }
 
 
@@ -317,15 +327,16 @@ namespace lacerta::physics
   paper_edge_stiffnesses(const std::array<mesh::Point3, 4> &x,
                          const double                       youngs_modulus)
   {
-    const double e_times_v = youngs_modulus * mesh::signed_volume(x[0], x[1], x[2], x[3]);
-    std::array<double, 6> k{};
+    std::array<double, 6> squared_length;
     for (unsigned int i = 0; i < 6; ++i)
     {
       const auto [a, b]    = mesh::TetMesh::edge_vertices[i];
       const mesh::Point3 d = mesh::sub(x[b], x[a]);
-      k[i]                 = e_times_v / mesh::dot(d, d);
+      squared_length[i]    = mesh::dot(d, d);
     }
-    return k;
+    return paper_edge_stiffnesses(youngs_modulus
+                                    * mesh::signed_volume(x[0], x[1], x[2], x[3]),
+                                  squared_length);
   }
 
 

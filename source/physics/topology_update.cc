@@ -23,7 +23,7 @@ namespace lacerta::physics
     constant_youngs_modulus = constant_value(youngs_modulus);
     const auto &k           = system.springs.stiffness;
     if ((system.fitted_springs || !system.cell_stiffness.empty()) && !k.empty())
-      fitted_floor = 1e-6 * *std::max_element(k.begin(), k.end());
+      stiffness_floor = 1e-6 * *std::max_element(k.begin(), k.end());
   }
 
 
@@ -55,13 +55,13 @@ namespace lacerta::physics
   {
     if (system.fitted_springs)
       return fitted_edge_stiffnesses(mesh, t, youngs_modulus, system.poisson_ratio);
-    std::array<double, 6> k{};
+    std::array<double, 6> squared_length;
     for (unsigned int i = 0; i < 6; ++i)
     {
       const double length = system.springs.rest_length[mesh.tet_edges(t)[i]];
-      k[i]                = terms.stiffness_factor / (length * length);
+      squared_length[i]   = length * length;
     }
-    return k;
+    return paper_edge_stiffnesses(terms.stiffness_factor, squared_length);
   }
 
 
@@ -158,7 +158,7 @@ namespace lacerta::physics
     if (system.fitted_springs || !cell_stiffness.empty())
       for (const unsigned int e : changed_springs)
         if (e < springs.size())
-          springs.stiffness[e] = std::max(springs.stiffness[e], fitted_floor);
+          springs.stiffness[e] = std::max(springs.stiffness[e], stiffness_floor);
     return added_ids;
   }
 

@@ -144,6 +144,16 @@ namespace lacerta::physics
                   const std::vector<std::array<double, 6>> &cell_stiffness);
 
   /**
+   * The paper's rule (Section 3.2): the contributions E V / |e|² of a tetrahedron to
+   * its six edges' stiffnesses, from its @p e_times_v = E V (tet_stiffness_factor())
+   * and the squares of its edges' rest lengths @p squared_length (local edge order).
+   * The one place the rule is written: the assembly, the local updates of cuts, tears
+   * and levels of detail and the MT's coarse cells all use it.
+   */
+  std::array<double, 6>
+  paper_edge_stiffnesses(double e_times_v, const std::array<double, 6> &squared_length);
+
+  /**
    * The contributions E V / |e|² of a tetrahedron with rest vertices @p x (positively
    * oriented) and Young's modulus @p youngs_modulus to its six edges' stiffnesses
    * (local order mesh::TetMesh::edge_vertices; Section 3.2).

@@ -159,8 +159,9 @@ namespace lacerta::physics
     double taken_out = 0, put_in = 0;
     /// The lumped masses the particles removed since the last take_out() held (kg).
     double removed_mass = 0;
-    /// With fitted springs or kept cell stiffnesses: the token stiffness of an edge
-    /// every cell dropped, 1e-6 of the stiffest spring when the update was made (N/m).
-    double fitted_floor = 0;
+    /// With fitted springs or kept cell stiffnesses (whose cells can give an edge
+    /// nothing): the token stiffness of an edge every cell dropped, 1e-6 of the
+    /// stiffest spring when the update was made (N/m).
+    double stiffness_floor = 0;
   };
 } // namespace lacerta::physics
