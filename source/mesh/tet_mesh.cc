@@ -96,6 +96,52 @@ namespace lacerta::mesh
       const unsigned int low = lesser(low_ab, c), high = high_ab ^ c ^ lesser(high_ab, c);
       return {{low, a ^ b ^ c ^ low ^ high, high}};
     }
+
+
+    /// The slot of edge (@p a, @p b), a < b, in the open-addressing table @p table (a
+    /// power of two of entries (a, b, id), never full): its entry, or the empty slot
+    /// where it goes.
+    inline std::array<unsigned int, 3> &
+    edge_slot(std::vector<std::array<unsigned int, 3>> &table,
+              const unsigned int                        a,
+              const unsigned int                        b)
+    {
+      const std::size_t mask = table.size() - 1;
+      std::size_t       h    = ((std::size_t(a) * 0x9E3779B97F4A7C15ULL)
+                       ^ (std::size_t(b) * 0xC2B2AE3D27D4EB4FULL))
+                      >> 20;
+      for (h &= mask;; h = (h + 1) & mask)
+      {
+        auto &slot = table[h];
+        if (slot[2] == invalid_index || (slot[0] == a && slot[1] == b))
+          return slot;
+      }
+    }
+
+
+    /// The slot of face @p key in the open-addressing table @p table (a power of two
+    /// of entries (a, b, c, 4 t + f), never full): its entry, or the empty slot where
+    /// it goes.
+    inline std::array<unsigned int, 4> &
+    face_slot(std::vector<std::array<unsigned int, 4>> &table, const FaceKey &key)
+    {
+      const std::size_t mask = table.size() - 1;
+      std::size_t       h    = (std::size_t(key[0]) * 0x9E3779B97F4A7C15ULL
+                       + std::size_t(key[1]) * 0xC2B2AE3D27D4EB4FULL
+                       + std::size_t(key[2]) * 0x165667B19E3779F9ULL)
+                      >> 20;
+      for (h &= mask;; h = (h + 1) & mask)
+      {
+        // Stop at the face or at an empty slot (slot[0] + 1 wraps to 0): one test
+        // of a product, as GCC splits a disjunction of comparisons into branches
+        // again, and which of the two it is follows no pattern.
+        auto              &slot = table[h];
+        const unsigned int differs =
+          (slot[0] ^ key[0]) | (slot[1] ^ key[1]) | (slot[2] ^ key[2]);
+        if (std::uint64_t(differs) * std::uint32_t(slot[0] + 1u) == 0)
+          return slot;
+      }
+    }
   } // namespace
 
 
@@ -599,16 +645,33 @@ namespace lacerta::mesh
                   " tetrahedra come with ",
                   face_ids.size(),
                   " lists of face boundary ids.");
-    ReplaceScratch &scratch = replace_scratch;
-    update.n_added_edges    = 0;
+    update.n_added_edges = 0;
     update.edge_moves.clear();
     update.tet_moves.clear();
+    number_new_edges(removed, added, update);
+    start_replace_marks();
+    take_out_tets(removed, added.size());
+    put_in_tets(removed, added, added_ids);
+    link_new_faces(added_ids);
+    close_open_faces(face_ids, added_ids);
+    retire_dead_edges(update);
+    refresh_boundary_flags();
+    fill_free_slots(removed, added.size(), added_ids, update);
+  }
+
+
+  void
+  TetMesh::number_new_edges(const std::vector<unsigned int> &removed,
+                            const std::vector<Tet>          &added,
+                            Update                          &update)
+  {
     // Edge ids of the new tets, looked up while the old tets are still in place, so
     // that an edge that survives keeps its id (and its spring). Edges not found are
     // numbered in the order they first appear. A small hash table of the edges seen
     // so far (found or made) answers their repetitions (an inner edge of the new
     // cells appears in several of them) without searching a star again.
-    auto &new_edge_ids = scratch.new_edge_ids;
+    ReplaceScratch &scratch      = replace_scratch;
+    auto           &new_edge_ids = scratch.new_edge_ids;
     new_edge_ids.resize(added.size());
     // The table first takes the removed cells' edges with their ids: most edges of
     // the new cells that already exist are theirs, found without a star search (an
@@ -622,27 +685,13 @@ namespace lacerta::mesh
       table_size *= 2;
     auto &created = scratch.created;
     clear_table(created, table_size);
-    // The slot of edge (a, b): its entry, or the empty slot where it goes.
-    const auto find_created = [&](const unsigned int a,
-                                  const unsigned int b) -> std::array<unsigned int, 3> &
-    {
-      std::size_t h = ((std::size_t(a) * 0x9E3779B97F4A7C15ULL)
-                       ^ (std::size_t(b) * 0xC2B2AE3D27D4EB4FULL))
-                      >> 20;
-      for (h &= table_size - 1;; h = (h + 1) & (table_size - 1))
-      {
-        auto &slot = created[h];
-        if (slot[2] == invalid_index || (slot[0] == a && slot[1] == b))
-          return slot;
-      }
-    };
     for (const unsigned int r : removed)
       for (unsigned int e = 0; e < 6; ++e)
       {
         const unsigned int x = tets[r][edge_vertices[e][0]],
                            y = tets[r][edge_vertices[e][1]];
         const unsigned int a = lesser(x, y), b = x ^ y ^ a;
-        find_created(a, b) = {{a, b, tet_edge_ids[r][e]}};
+        edge_slot(created, a, b) = {{a, b, tet_edge_ids[r][e]}};
       }
     for (std::size_t k = 0; k < added.size(); ++k)
       for (unsigned int e = 0; e < 6; ++e)
@@ -651,7 +700,7 @@ namespace lacerta::mesh
                            y = added[k][edge_vertices[e][1]];
         // Ordered without a branch (which end is smaller follows no pattern).
         const unsigned int a = lesser(x, y), b = x ^ y ^ a;
-        auto              &slot = find_created(a, b);
+        auto              &slot = edge_slot(created, a, b);
         if (slot[2] == invalid_index)
         {
           // Not an edge of a removed cell: one of a surviving cell, or a new one.
@@ -666,8 +715,15 @@ namespace lacerta::mesh
         }
         new_edge_ids[k][e] = slot[2];
       }
+  }
 
-    // Vertices whose boundary flag may change: those of the old and the new tets.
+
+  void
+  TetMesh::start_replace_marks()
+  {
+    // A new stamp marks what this update sees; when the stamps wrap, every mark is
+    // cleared once.
+    ReplaceScratch &scratch = replace_scratch;
     if (++scratch.stamp == 0)
     {
       std::fill(scratch.vertex_stamp.begin(), scratch.vertex_stamp.end(), 0u);
@@ -676,55 +732,37 @@ namespace lacerta::mesh
       std::fill(scratch.tet_stamp.begin(), scratch.tet_stamp.end(), 0u);
       scratch.stamp = 1;
     }
+    // Vertices whose boundary flag may change: those of the old and the new tets.
     scratch.vertex_stamp.resize(vertices.size(), 0);
     scratch.fresh_stamp.resize(vertices.size(), 0);
     scratch.refresh.clear();
-    const auto note_vertex = [&](const unsigned int v)
-    {
-      if (scratch.vertex_stamp[v] != scratch.stamp)
-      {
-        scratch.vertex_stamp[v] = scratch.stamp;
-        scratch.refresh.push_back(v);
-      }
-    };
+  }
 
+
+  void
+  TetMesh::take_out_tets(const std::vector<unsigned int> &removed,
+                         const std::size_t                n_added)
+  {
     // Take the old tets out: stars, boundary faces, neighbours' back links. Their
     // edges, once each (an edge id names one edge), are candidates for retirement.
     // An edge of a new tet lives on: marking those first leaves as candidates only
     // the edges that just the remaining old tets may still hold.
-    auto &old_edges = scratch.old_edges;
+    ReplaceScratch &scratch   = replace_scratch;
+    auto           &old_edges = scratch.old_edges;
     old_edges.clear();
     scratch.edge_stamp.resize(edges.size(), 0);
     edge_uses.resize(edges.size(), 0);
-    for (const auto &ids : new_edge_ids)
+    for (const auto &ids : scratch.new_edge_ids)
       for (const unsigned int id : ids)
         scratch.edge_stamp[id] = scratch.stamp;
-    // Faces by key, for the neighbours below: the removed cells' faces whose
-    // neighbour survives go in now, the new cells' faces later. The table holds at
-    // most four faces per cell involved, so it never fills and probing always ends.
+    // Faces by key, for the neighbours (link_new_faces()): the removed cells' faces
+    // whose neighbour survives go in now, the new cells' faces later. The table holds
+    // at most four faces per cell involved, so it never fills and probing always ends.
     std::size_t face_table_size = 16;
-    while (face_table_size <= 4 * (added.size() + removed.size()))
+    while (face_table_size <= 4 * (n_added + removed.size()))
       face_table_size *= 2;
     auto &face_table = scratch.faces;
     clear_table(face_table, face_table_size);
-    const auto find_face = [&](const FaceKey &key) -> std::array<unsigned int, 4> &
-    {
-      std::size_t h = (std::size_t(key[0]) * 0x9E3779B97F4A7C15ULL
-                       + std::size_t(key[1]) * 0xC2B2AE3D27D4EB4FULL
-                       + std::size_t(key[2]) * 0x165667B19E3779F9ULL)
-                      >> 20;
-      for (h &= face_table_size - 1;; h = (h + 1) & (face_table_size - 1))
-      {
-        // Stop at the face or at an empty slot (slot[0] + 1 wraps to 0): one test
-        // of a product, as GCC splits a disjunction of comparisons into branches
-        // again, and which of the two it is follows no pattern.
-        auto              &slot = face_table[h];
-        const unsigned int differs =
-          (slot[0] ^ key[0]) | (slot[1] ^ key[1]) | (slot[2] ^ key[2]);
-        if (std::uint64_t(differs) * std::uint32_t(slot[0] + 1u) == 0)
-          return slot;
-      }
-    };
     scratch.tet_stamp.resize(tets.size(), 0);
     for (const unsigned int r : removed)
       scratch.tet_stamp[r] = scratch.stamp;
@@ -741,7 +779,7 @@ namespace lacerta::mesh
         old_edges.push_back({{std::min(a, b), std::max(a, b), id}});
       }
       for (const unsigned int v : tets[r])
-        note_vertex(v);
+        scratch.note_vertex(v);
       for (unsigned int f = 0; f < 4; ++f)
       {
         remove_boundary_face(r, f);
@@ -753,24 +791,31 @@ namespace lacerta::mesh
               neighbors[4 * n + g] = invalid_index;
               if (scratch.tet_stamp[n] != scratch.stamp)
               {
-                const FaceKey key = face_key(tets[r], f);
-                find_face(key)    = {{key[0], key[1], key[2], 4 * n + g}};
+                const FaceKey key          = face_key(tets[r], f);
+                face_slot(face_table, key) = {{key[0], key[1], key[2], 4 * n + g}};
               }
             }
         neighbors[4 * r + f] = invalid_index;
       }
     }
-
     // The removed tets leave the stars of their vertices (so far exactly the noted
     // ones), all of a star's at once.
     for (const unsigned int v : scratch.refresh)
       vertex_tets.erase_marked(v,
                                [&](const unsigned int t)
                                { return scratch.tet_stamp[t] == scratch.stamp; });
+  }
 
+
+  void
+  TetMesh::put_in_tets(const std::vector<unsigned int> &removed,
+                       const std::vector<Tet>          &added,
+                       std::vector<unsigned int>       &added_ids)
+  {
     // Put the new tets in: the first ones into the removed ones' slots, the others
     // appended (the arrays grow once, not once per tet). Slots left free are filled
-    // at the end.
+    // at the end (fill_free_slots()).
+    ReplaceScratch &scratch = replace_scratch;
     added_ids.resize(added.size());
     const std::size_t n_old = tets.size(),
                       n_new =
@@ -788,8 +833,8 @@ namespace lacerta::mesh
       if (k < removed.size())
         scratch.tet_stamp[slot] = 0;
       tets[slot]         = added[k];
-      tet_edge_ids[slot] = new_edge_ids[k];
-      for (const unsigned int id : new_edge_ids[k])
+      tet_edge_ids[slot] = scratch.new_edge_ids[k];
+      for (const unsigned int id : scratch.new_edge_ids[k])
         ++edge_uses[id];
       for (const unsigned int v : added[k])
       {
@@ -797,24 +842,28 @@ namespace lacerta::mesh
         if (vertex_tets.star_size(v) == 0)
           scratch.fresh_stamp[v] = scratch.stamp;
         vertex_tets.insert(v, slot);
-        note_vertex(v);
+        scratch.note_vertex(v);
       }
     }
+  }
+
+
+  void
+  TetMesh::link_new_faces(const std::vector<unsigned int> &added_ids)
+  {
     // Neighbours, by the faces' sorted vertex triples (a face has at most two cells,
     // the caller guarantees it, and a neighbour shares all three vertices). The other
     // cell of a new cell's face is another new cell, or a surviving cell that was the
-    // neighbour of a removed one across that face (listed above), or, rarely, a
-    // surviving cell whose face was on the boundary: only the faces still without a
-    // neighbour are searched for in a star, and not even those with a vertex that only
-    // new cells hold. A table lookup instead of a star scan per face: the scan's
-    // membership tests were the update's most mispredicted branches.
-    for (std::size_t k = 0; k < added.size(); ++k)
-    {
-      const unsigned int t = added_ids[k];
+    // neighbour of a removed one across that face (take_out_tets() listed it), or,
+    // rarely, a surviving cell whose face was on the boundary (close_open_faces()). A
+    // table lookup instead of a star scan per face: the scan's membership tests were
+    // the update's most mispredicted branches.
+    auto &face_table = replace_scratch.faces;
+    for (const unsigned int t : added_ids)
       for (unsigned int f = 0; f < 4; ++f)
       {
         const FaceKey key  = face_key(tets[t], f);
-        auto         &slot = find_face(key);
+        auto         &slot = face_slot(face_table, key);
         // Whether the face is already there (half of them) follows no pattern:
         // selects instead of branches. A hit leaves the entry as it is; a miss
         // enters the face and writes invalid_index where it already is
@@ -826,11 +875,19 @@ namespace lacerta::mesh
         neighbors[own]           = (other / 4) | ~hit;
         neighbors[other]         = t | ~hit;
       }
-    }
+  }
+
+
+  void
+  TetMesh::close_open_faces(const std::vector<std::array<unsigned int, 4>> &face_ids,
+                            const std::vector<unsigned int>                &added_ids)
+  {
     // The faces left are boundary faces unless a surviving cell has the same three
     // vertices (the new cells then close a boundary). In the order of the new cells
-    // and their faces, as the boundary face list's order depends on it.
-    for (std::size_t k = 0; k < added.size(); ++k)
+    // and their faces, as the boundary face list's order depends on it. A face with a
+    // vertex that only new cells hold is not searched for.
+    const ReplaceScratch &scratch = replace_scratch;
+    for (std::size_t k = 0; k < added_ids.size(); ++k)
     {
       const unsigned int t = added_ids[k];
       for (unsigned int f = 0; f < 4; ++f)
@@ -877,14 +934,19 @@ namespace lacerta::mesh
         }
       }
     }
+  }
 
+
+  void
+  TetMesh::retire_dead_edges(Update &update)
+  {
     // Retire the edges no tetrahedron uses any more, largest id first, so that the
     // last slot moved into a hole is always a live edge. The counts of uses answer
     // without searching a star for a cell with both ends (a dead edge's search read
     // the whole star).
-    auto &dead = scratch.dead;
+    auto &dead = replace_scratch.dead;
     dead.clear();
-    for (const auto &e : old_edges)
+    for (const auto &e : replace_scratch.old_edges)
       if (edge_uses[e[2]] == 0)
         dead.push_back(e[2]);
     std::sort(dead.rbegin(), dead.rend());
@@ -908,9 +970,14 @@ namespace lacerta::mesh
       edges.pop_back();
       edge_uses.pop_back();
     }
+  }
 
+
+  void
+  TetMesh::refresh_boundary_flags()
+  {
     // Boundary flags of every vertex involved, once each.
-    for (const unsigned int v : scratch.refresh)
+    for (const unsigned int v : replace_scratch.refresh)
     {
       if (v >= boundary_vertex.size())
         boundary_vertex.resize(v + 1, 0);
@@ -932,36 +999,44 @@ namespace lacerta::mesh
       }
       boundary_vertex[v] = on_boundary;
     }
+  }
 
+
+  void
+  TetMesh::fill_free_slots(const std::vector<unsigned int> &removed,
+                           const std::size_t                n_added,
+                           std::vector<unsigned int>       &added_ids,
+                           Update                          &update)
+  {
     // Fewer tets came than went: the slots still marked removed are filled from the
     // end, a free slot below the new size with the last tet that is not free.
-    if (added.size() < removed.size())
+    if (n_added >= removed.size())
+      return;
+    ReplaceScratch &scratch = replace_scratch;
+    auto           &holes   = scratch.dead;
+    holes.assign(removed.begin() + n_added, removed.end());
+    std::sort(holes.begin(), holes.end());
+    const std::size_t n_kept = tets.size() - holes.size();
+    std::size_t       from   = tets.size();
+    for (const unsigned int to : holes)
     {
-      auto &holes = scratch.dead;
-      holes.assign(removed.begin() + added.size(), removed.end());
-      std::sort(holes.begin(), holes.end());
-      const std::size_t n_kept = tets.size() - holes.size();
-      std::size_t       from   = tets.size();
-      for (const unsigned int to : holes)
-      {
-        if (to >= n_kept)
-          break;
-        do
-          --from;
-        while (scratch.tet_stamp[from] == scratch.stamp);
-        move_tet(static_cast<unsigned int>(from), to);
-        update.tet_moves.push_back({{to, static_cast<unsigned int>(from)}});
-      }
-      for (const auto &[to, moved] : update.tet_moves)
-        for (unsigned int &id : added_ids)
-          if (id == moved)
-            id = to;
-      tets.resize(n_kept);
-      tet_edge_ids.resize(n_kept);
-      neighbors.resize(4 * n_kept);
-      boundary_slot.resize(4 * n_kept);
-      scratch.tet_stamp.resize(n_kept);
+      if (to >= n_kept)
+        break;
+      do
+        --from;
+      while (scratch.tet_stamp[from] == scratch.stamp);
+      move_tet(static_cast<unsigned int>(from), to);
+      update.tet_moves.push_back({{to, static_cast<unsigned int>(from)}});
     }
+    for (const auto &[to, moved] : update.tet_moves)
+      for (unsigned int &id : added_ids)
+        if (id == moved)
+          id = to;
+    tets.resize(n_kept);
+    tet_edge_ids.resize(n_kept);
+    neighbors.resize(4 * n_kept);
+    boundary_slot.resize(4 * n_kept);
+    scratch.tet_stamp.resize(n_kept);
   }
 
 

@@ -231,53 +231,87 @@ namespace lacerta::physics
       return statistics;
     }
     require_mesh(system);
-    const mesh::TetMesh &mesh = *system.mesh;
+    start_rebalance(system, particles);
+    const double limit = donor_headroom * target_lambda;
+    take_back_gifts(system, limit);
+    return_gifts(system);
+    statistics.raised = raise_particles(system, limit);
+    record_changes(system, limit);
+    statistics.moved      = positive_shift;
+    statistics.unresolved = n_unresolved;
+    return statistics;
+  }
+
+
+  template <typename F>
+  void
+  MassBalancer::for_each_neighbour(const mesh::TetMesh &mesh,
+                                   const unsigned int   p,
+                                   const F             &f)
+  {
     // The particles joined to p by a spring: the other vertices of its cells.
-    mark.resize(n, 0);
-    const auto for_each_neighbour = [&](const unsigned int p, const auto &f)
+    if (++stamp == 0)
     {
-      if (++stamp == 0)
-      {
-        std::fill(mark.begin(), mark.end(), 0);
-        stamp = 1;
-      }
-      mark[p] = stamp;
-      for (const unsigned int t : mesh.tets_of_vertex(p))
-        for (const unsigned int q : mesh.tet(t))
-          if (mark[q] != stamp)
-          {
-            mark[q] = stamp;
-            f(q);
-          }
-    };
-    // The particles within reach of @p start (distinct), appended to `region` after
-    // them; in_region marks them all.
-    in_region.resize(n, 0);
-    const auto grow_region = [&](const std::vector<unsigned int> &start)
-    {
-      region.clear();
-      for (const unsigned int p : start)
-        if (!in_region[p])
+      std::fill(mark.begin(), mark.end(), 0);
+      stamp = 1;
+    }
+    mark[p] = stamp;
+    for (const unsigned int t : mesh.tets_of_vertex(p))
+      for (const unsigned int q : mesh.tet(t))
+        if (mark[q] != stamp)
         {
-          in_region[p] = 1;
-          region.push_back(p);
+          mark[q] = stamp;
+          f(q);
         }
-      for (std::size_t first = 0, hop = 0; hop < reach; ++hop)
-      {
-        const std::size_t last = region.size();
-        for (std::size_t k = first; k < last; ++k)
-          for_each_neighbour(region[k],
-                             [&](const unsigned int q)
-                             {
-                               if (!in_region[q])
-                               {
-                                 in_region[q] = 1;
-                                 region.push_back(q);
-                               }
-                             });
-        first = last;
-      }
-    };
+  }
+
+
+  void
+  MassBalancer::touch(const ParticleSystem &system, const unsigned int p)
+  {
+    if (touched_mark[p] != touched_stamp)
+    {
+      touched_mark[p] = touched_stamp;
+      touched.push_back(p);
+      before_of[p] = system.mass[p];
+    }
+  }
+
+
+  void
+  MassBalancer::compute_rows(const ParticleSystem            &system,
+                             const std::vector<unsigned int> &rows)
+  {
+    row_values.resize(rows.size());
+    gershgorin_row_sums(
+      system, system.rest_position().data(), rows, scratch, row_values.data());
+    for (std::size_t k = 0; k < rows.size(); ++k)
+    {
+      row_sum[rows[k]]   = row_values[k];
+      row_known[rows[k]] = row_stamp;
+    }
+  }
+
+
+  double
+  MassBalancer::row(const ParticleSystem &system, const unsigned int j)
+  {
+    if (row_known[j] != row_stamp)
+    {
+      single_row.assign(1, j);
+      compute_rows(system, single_row);
+    }
+    return row_sum[j];
+  }
+
+
+  void
+  MassBalancer::start_rebalance(const ParticleSystem            &system,
+                                const std::vector<unsigned int> &particles)
+  {
+    const unsigned int n = system.n_particles();
+    mark.resize(n, 0);
+    in_region.resize(n, 0);
     gifts_of.resize(n);
     before_of.resize(n, 0.0);
     momentum_of.resize(3 * std::size_t(n), 0.0);
@@ -285,15 +319,6 @@ namespace lacerta::physics
     mass_out.resize(n, 0.0);
     outgoing.resize(3 * std::size_t(n), 0.0);
     touched.clear();
-    const auto touch = [&](const unsigned int p)
-    {
-      if (touched_mark[p] != touched_stamp)
-      {
-        touched_mark[p] = touched_stamp;
-        touched.push_back(p);
-        before_of[p] = system.mass[p];
-      }
-    };
     // Gifts between particles within reach of the change are taken back: the change
     // may have separated giver and taker (a cut between them crosses an edge of every
     // path of at most `reach` springs, at changed particles), and the changed
@@ -307,11 +332,35 @@ namespace lacerta::physics
       std::fill(touched_mark.begin(), touched_mark.end(), 0);
       touched_stamp = 1;
     }
-    grow_region(to_check);
-    // The rows at rest, computed when first asked for: those of the particles to
-    // check at once, a donor's when its taker asks its ring. A particle the change did
-    // not touch and that gives nothing keeps its mass and its springs, hence its row
-    // and whether it is above the limit: the cost follows the particles that need
+    // The region: the particles within reach of those to check (distinct), after
+    // them; in_region marks them all.
+    region.clear();
+    for (const unsigned int p : to_check)
+      if (!in_region[p])
+      {
+        in_region[p] = 1;
+        region.push_back(p);
+      }
+    for (std::size_t first = 0, hop = 0; hop < reach; ++hop)
+    {
+      const std::size_t last = region.size();
+      for (std::size_t k = first; k < last; ++k)
+        for_each_neighbour(*system.mesh,
+                           region[k],
+                           [&](const unsigned int q)
+                           {
+                             if (!in_region[q])
+                             {
+                               in_region[q] = 1;
+                               region.push_back(q);
+                             }
+                           });
+      first = last;
+    }
+    // The rows at rest, computed when first asked for (row()): those of the particles
+    // to check at once, a donor's when its taker asks its ring. A particle the change
+    // did not touch and that gives nothing keeps its mass and its springs, hence its
+    // row and whether it is above the limit: the cost follows the particles that need
     // mass, not every particle within reach of the change.
     if (++row_stamp == 0)
     {
@@ -320,45 +369,30 @@ namespace lacerta::physics
     }
     row_known.resize(n, 0);
     row_sum.resize(n, 0.0);
-    const auto compute_rows = [&](const std::vector<unsigned int> &rows)
-    {
-      row_values.resize(rows.size());
-      gershgorin_row_sums(
-        system, system.rest_position().data(), rows, scratch, row_values.data());
-      for (std::size_t k = 0; k < rows.size(); ++k)
-      {
-        row_sum[rows[k]]   = row_values[k];
-        row_known[rows[k]] = row_stamp;
-      }
-    };
-    compute_rows(to_check);
-    const auto row = [&](const unsigned int j)
-    {
-      if (row_known[j] != row_stamp)
-      {
-        single_row.assign(1, j);
-        compute_rows(single_row);
-      }
-      return row_sum[j];
-    };
-    const double limit = donor_headroom * target_lambda;
+    compute_rows(system, to_check);
+  }
+
+
+  void
+  MassBalancer::take_back_gifts(const ParticleSystem &system, const double limit)
+  {
     // A taker left unable to afford what it gave on (its mass after the take-backs
     // below what keeps its bound at the donors' limit, or even negative) owes it: its
     // own gifts are taken back with it (cascade). One that can afford them keeps
     // them: otherwise the light particles along a crack, each raised in part by the
     // one before, would form chains of gifts as long as the crack, and every cut step
     // would take back and give again along all of it. The gifts are taken back at
-    // once, each with the velocity its taker has now: taken back one after the
-    // other, a particle could hold a negative mass in between, and the velocity of
-    // what it then receives would be divided by it.
+    // once, each with the velocity its taker has now (return_gifts()): taken back one
+    // after the other, a particle could hold a negative mass in between, and the
+    // velocity of what it then receives would be divided by it.
     cascade.clear();
     taken_back.clear();
-    pending.resize(n, 0.0);
+    pending.resize(system.n_particles(), 0.0);
     const auto take_back = [&](const unsigned int g)
     {
       Gift &gift = gifts[g];
-      touch(gift.donor);
-      touch(gift.taker);
+      touch(system, gift.donor);
+      touch(system, gift.taker);
       taken_back.push_back(g);
       to_check.push_back(gift.taker);
       cascade.push_back(gift.taker);
@@ -377,7 +411,7 @@ namespace lacerta::physics
     {
       const unsigned int t = cascade.back();
       cascade.pop_back();
-      if (system.mass[t] + pending[t] >= row(t) / limit)
+      if (system.mass[t] + pending[t] >= row(system, t) / limit)
         continue;
       for (const unsigned int g : gifts_of[t])
         if (gifts[g].mass > 0 && gifts[g].donor == t)
@@ -385,6 +419,12 @@ namespace lacerta::physics
     }
     for (const unsigned int p : touched)
       pending[p] = 0;
+  }
+
+
+  void
+  MassBalancer::return_gifts(ParticleSystem &system)
+  {
     // Mass and momentum: each gift goes back to its donor with the velocity u of its
     // taker, and every particle's new velocity is the mass-weighted mean of what it
     // keeps and what it receives, so momentum is kept and kinetic energy cannot grow
@@ -472,52 +512,73 @@ namespace lacerta::physics
     compact_gifts();
     for (const unsigned int p : region)
       in_region[p] = 0;
-    std::sort(to_check.begin(), to_check.end());
-    to_check.erase(std::unique(to_check.begin(), to_check.end()), to_check.end());
-    const std::size_t n_changed = to_check.size();
-    const auto        lambda    = [&](const unsigned int i)
-    {
-      const double m = system.mass[i];
-      return m > 0 ? row(i) / m : std::numeric_limits<double>::infinity();
-    };
+  }
 
+
+  double
+  MassBalancer::lambda_at_rest(const ParticleSystem &system, const unsigned int i)
+  {
+    const double m = system.mass[i];
+    return m > 0 ? row(system, i) / m : std::numeric_limits<double>::infinity();
+  }
+
+
+  unsigned int
+  MassBalancer::raise_particles(ParticleSystem &system, const double limit)
+  {
     // As balance() does, over the changed particles only (in increasing order), from
     // the masses as they are: the cutter updates the lumped part of a mass and keeps
     // the part moved before (mass_shift).
-    const double tolerance = 1 + 1e-9;
+    std::sort(to_check.begin(), to_check.end());
+    to_check.erase(std::unique(to_check.begin(), to_check.end()), to_check.end());
+    const std::size_t n_changed = to_check.size();
+    const double      tolerance = 1 + 1e-9;
     for (const unsigned int p : to_check)
-      touch(p);
-    seen.resize(n, 0);
+      touch(system, p);
+    seen.resize(system.n_particles(), 0);
+    unsigned int raised = 0;
     for (std::size_t k = 0; k < n_changed; ++k)
     {
       const unsigned int i = to_check[k];
-      if (!(system.free[i] > 0) || !(lambda(i) > tolerance * target_lambda))
+      if (!(system.free[i] > 0)
+          || !(lambda_at_rest(system, i) > tolerance * target_lambda))
         continue;
-      const double need  = row(i) / (target_lambda / (1 + 1e-6)) - system.mass[i];
-      const double moved = borrow(system,
-                                  for_each_neighbour,
-                                  row,
-                                  i,
-                                  need,
-                                  limit,
-                                  reach,
-                                  seen,
-                                  spare,
-                                  donors,
-                                  ring_first,
-                                  ring,
-                                  [&](const unsigned int d, const double m)
-                                  {
-                                    touch(d);
-                                    record_gift(d, i, m);
-                                  });
-      statistics.raised += moved > 0;
+      const double need  = row(system, i) / (target_lambda / (1 + 1e-6)) - system.mass[i];
+      const double moved = borrow(
+        system,
+        [&](const unsigned int p, const auto &f)
+        { for_each_neighbour(*system.mesh, p, f); },
+        [&](const unsigned int j) { return row(system, j); },
+        i,
+        need,
+        limit,
+        reach,
+        seen,
+        spare,
+        donors,
+        ring_first,
+        ring,
+        [&](const unsigned int d, const double m)
+        {
+          touch(system, d);
+          record_gift(d, i, m);
+        });
+      raised += moved > 0;
     }
+    return raised;
+  }
+
+
+  void
+  MassBalancer::record_changes(ParticleSystem &system, const double limit)
+  {
     // Whether each particle is above the limit changes only where a mass or a row
     // changed: at the particles checked and those that gave or took back.
+    const double tolerance = 1 + 1e-9;
     for (const unsigned int p : touched)
     {
-      const bool above = system.free[p] > 0 && lambda(p) > tolerance * limit;
+      const bool above =
+        system.free[p] > 0 && lambda_at_rest(system, p) > tolerance * limit;
       n_unresolved += static_cast<unsigned int>(above) - unresolved[p];
       unresolved[p] = above;
     }
@@ -533,9 +594,6 @@ namespace lacerta::physics
     }
     if (!changed.empty())
       system.masses_changed(changed);
-    statistics.moved      = positive_shift;
-    statistics.unresolved = n_unresolved;
-    return statistics;
   }
 
 

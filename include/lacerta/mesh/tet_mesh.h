@@ -365,7 +365,61 @@ namespace lacerta::mesh
       std::vector<unsigned int>                dead, refresh, vertex_stamp, edge_stamp;
       std::vector<unsigned int>                fresh_stamp, tet_stamp;
       unsigned int                             stamp = 0;
+
+      /// Notes vertex @p v (in `refresh`) unless the current update did.
+      void
+      note_vertex(const unsigned int v)
+      {
+        if (vertex_stamp[v] != stamp)
+        {
+          vertex_stamp[v] = stamp;
+          refresh.push_back(v);
+        }
+      }
     };
+
+    /// replace_tets(), stage 1: the edge ids of the @p added tets (`new_edge_ids`),
+    /// those of existing edges kept, new edges appended to `edges`.
+    void
+    number_new_edges(const std::vector<unsigned int> &removed,
+                     const std::vector<Tet>          &added,
+                     Update                          &update);
+    /// Stage 2: a new stamp for the update's marks.
+    void
+    start_replace_marks();
+    /// Stage 3: takes the @p removed tets out of the edge counts, the boundary faces,
+    /// their neighbours' links and the vertex stars; lists their edges (`old_edges`)
+    /// and the faces whose neighbour survives (`faces`).
+    void
+    take_out_tets(const std::vector<unsigned int> &removed, std::size_t n_added);
+    /// Stage 4: puts the @p added tets into the removed ones' slots, then at the end,
+    /// into @p added_ids; their edges and stars.
+    void
+    put_in_tets(const std::vector<unsigned int> &removed,
+                const std::vector<Tet>          &added,
+                std::vector<unsigned int>       &added_ids);
+    /// Stage 5: the new tets' neighbours across faces that `faces` knows.
+    void
+    link_new_faces(const std::vector<unsigned int> &added_ids);
+    /// Stage 6: the new tets' faces still open: a surviving cell's face, or a
+    /// boundary face with id @p face_ids[k][f].
+    void
+    close_open_faces(const std::vector<std::array<unsigned int, 4>> &face_ids,
+                     const std::vector<unsigned int>                &added_ids);
+    /// Stage 7: retires the old edges no tetrahedron uses any more (into
+    /// `update.edge_moves`).
+    void
+    retire_dead_edges(Update &update);
+    /// Stage 8: the boundary flags of the vertices the update involved.
+    void
+    refresh_boundary_flags();
+    /// Stage 9: when fewer tets came than went, fills the free slots from the end
+    /// (into `update.tet_moves` and @p added_ids).
+    void
+    fill_free_slots(const std::vector<unsigned int> &removed,
+                    std::size_t                      n_added,
+                    std::vector<unsigned int>       &added_ids,
+                    Update                          &update);
 
     /// Removes boundary face (t, f) if it is one.
     void

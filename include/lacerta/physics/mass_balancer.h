@@ -14,6 +14,10 @@ namespace lacerta
 {
   class Archive;
 }
+namespace lacerta::mesh
+{
+  class TetMesh;
+}
 namespace lacerta::physics
 {
   class ParticleSystem;
@@ -143,6 +147,45 @@ namespace lacerta::physics
     /// Rebuilds the ledger without the gifts taken back once they are most of it.
     void
     compact_gifts();
+
+    /// rebalance(), stage 1: the particles to check (@p particles), the region within
+    /// reach of them, their rows at rest.
+    void
+    start_rebalance(const ParticleSystem            &system,
+                    const std::vector<unsigned int> &particles);
+    /// Stage 2: takes back the gifts in the region, and those of takers that can no
+    /// longer afford what they gave on (the donors' limit @p limit).
+    void
+    take_back_gifts(const ParticleSystem &system, double limit);
+    /// Stage 3: the gifts taken back return to their donors, with mass and momentum.
+    void
+    return_gifts(ParticleSystem &system);
+    /// Stage 4: raises the particles to check whose bound exceeds the target, from
+    /// donors below @p limit; returns how many were raised.
+    unsigned int
+    raise_particles(ParticleSystem &system, double limit);
+    /// Stage 5: the flags of the particles above @p limit, the mass shifts, and the
+    /// system told which masses changed.
+    void
+    record_changes(ParticleSystem &system, double limit);
+    /// Calls @p f(q) for every particle q joined to @p p by a spring (an edge of
+    /// @p mesh), once each.
+    template <typename F>
+    void
+    for_each_neighbour(const mesh::TetMesh &mesh, unsigned int p, const F &f);
+    /// Notes that particle @p p's mass may change in this call (`touched`, with its
+    /// mass before).
+    void
+    touch(const ParticleSystem &system, unsigned int p);
+    /// Computes the rows at rest @p rows into `row_sum`.
+    void
+    compute_rows(const ParticleSystem &system, const std::vector<unsigned int> &rows);
+    /// Particle @p j's row at rest, computed if this call has not yet.
+    double
+    row(const ParticleSystem &system, unsigned int j);
+    /// Particle @p i's bound at rest with its mass as it is (infinite if not positive).
+    double
+    lambda_at_rest(const ParticleSystem &system, unsigned int i);
 
     /// Scratch of rebalance(), kept so that a local call allocates nothing once grown.
     std::vector<unsigned int> region, mark, to_check, touched, touched_mark;
