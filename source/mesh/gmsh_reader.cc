@@ -306,6 +306,29 @@ namespace lacerta::mesh
     }
 
 
+    /// Reads the counts that open a format-4.1 section of @p kind ("node" or
+    /// "element") blocks; returns the number of blocks.
+    std::size_t
+    read_block_count(SectionReader &in, const std::string &kind)
+    {
+      const std::size_t n_blocks =
+        in.integer(("the number of " + kind + " blocks").c_str());
+      in.integer(("the number of " + kind + "s").c_str());
+      in.integer(("the smallest " + kind + " tag").c_str());
+      in.integer(("the largest " + kind + " tag").c_str());
+      return n_blocks;
+    }
+
+
+    /// Skips the entity dimension and tag that open a format-4.1 block.
+    void
+    skip_entity(SectionReader &in)
+    {
+      in.integer("the entity dimension");
+      in.integer("the entity tag");
+    }
+
+
     /// The nodes of a gmsh file: their coordinates, and their tags both ways.
     struct Nodes
     {
@@ -353,14 +376,10 @@ namespace lacerta::mesh
       }
       else
       {
-        const std::size_t n_blocks = nodes.integer("the number of node blocks");
-        nodes.integer("the number of nodes");
-        nodes.integer("the smallest node tag");
-        nodes.integer("the largest node tag");
+        const std::size_t n_blocks = read_block_count(nodes, "node");
         for (std::size_t b = 0; b < n_blocks; ++b)
         {
-          nodes.integer("the entity dimension");
-          nodes.integer("the entity tag");
+          skip_entity(nodes);
           const std::size_t        parametric = nodes.integer("the parametric flag");
           const std::size_t        n = nodes.integer("the number of nodes in the block");
           std::vector<std::size_t> tags(n);
@@ -403,15 +422,10 @@ namespace lacerta::mesh
       }
       else
       {
-        const std::size_t n_blocks =
-          element_reader.integer("the number of element blocks");
-        element_reader.integer("the number of elements");
-        element_reader.integer("the smallest element tag");
-        element_reader.integer("the largest element tag");
+        const std::size_t n_blocks = read_block_count(element_reader, "element");
         for (std::size_t b = 0; b < n_blocks; ++b)
         {
-          element_reader.integer("the entity dimension");
-          element_reader.integer("the entity tag");
+          skip_entity(element_reader);
           const std::size_t type = element_reader.integer("the element type");
           const std::size_t n =
             element_reader.integer("the number of elements in the block");
