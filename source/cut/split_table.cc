@@ -139,6 +139,213 @@ namespace lacerta::cut
       corners = sorted;
     }
 
+    /// A pattern of vertex sides of a plane against the reference tetrahedron: each
+    /// vertex +1, -1 or 0 (on the plane), and the masks of each kind.
+    struct SidePattern
+    {
+      std::array<int, 4> side{};
+      unsigned           zmask = 0, pmask = 0, nmask = 0;
+    };
+
+
+    /// Side pattern number @p code (base 3, one digit per vertex).
+    SidePattern
+    side_pattern(const unsigned code)
+    {
+      SidePattern p;
+      for (unsigned v = 0, c = code; v < 4; ++v, c /= 3)
+        p.side[v] = static_cast<int>(c % 3) - 1;
+      for (unsigned v = 0; v < 4; ++v)
+        (p.side[v] == 0 ? p.zmask : (p.side[v] > 0 ? p.pmask : p.nmask)) |= 1u << v;
+      return p;
+    }
+
+
+    /// The configuration of a plane that touches the tetrahedron at the vertices
+    /// @p zmask (or misses it), added once.
+    void
+    add_touch_configuration(std::map<Key, Configuration> &configurations,
+                            const unsigned                zmask)
+    {
+      const auto X   = reference_tetrahedron();
+      const Key  key = make_key(0, zmask, 0);
+      auto      &cfg = configurations[key];
+      if (!cfg.samples.empty())
+        return;
+      const unsigned n = popcount(zmask);
+      cfg.kind         = n == 0 ? CutKind::none : CutKind::touch;
+      cfg.vertices     = static_cast<std::uint8_t>(zmask);
+      cfg.name =
+        n == 0 ? "none" : (n == 1 ? "touch-v" : (n == 2 ? "touch-e" : "touch-f"));
+      Sample s;
+      for (unsigned v = 0; v < 4; ++v)
+        s.x[v] = X[v];
+      cfg.samples.push_back(s);
+    }
+
+
+    /// A random plane realising @p pattern, through its first three @p corners
+    /// (vertices, or random points on the @p crossing edges), into @p s with the
+    /// section's sorted corners; false if the plane drawn does not realise it well
+    /// (nearly degenerate, or a vertex or a cut point too close to it).
+    bool
+    random_section(const SidePattern         &pattern,
+                   const std::vector<Corner> &corners,
+                   const unsigned             crossing,
+                   std::mt19937              &rng,
+                   Sample                    &s)
+    {
+      const auto                             X = reference_tetrahedron();
+      std::uniform_real_distribution<double> param(0.02, 0.98);
+      for (unsigned v = 0; v < 4; ++v)
+        s.x[v] = X[v];
+      std::array<Point, 3> through;
+      for (unsigned k = 0; k < 3; ++k)
+      {
+        const Corner &c = corners[k];
+        if (c.is_vertex)
+          through[k] = X[c.index];
+        else
+        {
+          const unsigned i = tet_edge_vertices[c.index][0],
+                         j = tet_edge_vertices[c.index][1];
+          through[k]       = lerp(X[i], X[j], param(rng));
+        }
+      }
+      Point normal = cross(sub(through[1], through[0]), sub(through[2], through[0]));
+      const double length = norm(normal);
+      if (length < 1e-6)
+        return false;
+      normal      = scale(1.0 / length, normal);
+      s.origin    = through[0];
+      bool   ok   = true;
+      double flip = 0;
+      for (unsigned v = 0; v < 4; ++v)
+      {
+        s.d[v] = dot(normal, sub(X[v], s.origin));
+        if (pattern.side[v] == 0)
+        {
+          s.d[v] = 0;
+          continue;
+        }
+        if (std::abs(s.d[v]) < 1e-3)
+          ok = false;
+        const double f = s.d[v] * pattern.side[v] > 0 ? 1 : -1;
+        if (flip == 0)
+          flip = f;
+        else if (flip != f)
+          ok = false;
+      }
+      if (!ok)
+        return false;
+      // Orient the normal towards the pattern's + side.
+      s.normal = scale(flip, normal);
+      for (unsigned v = 0; v < 4; ++v)
+        s.d[v] *= flip;
+      for (unsigned e = 0; e < 6; ++e)
+        if (crossing & (1u << e))
+        {
+          const unsigned i = tet_edge_vertices[e][0], j = tet_edge_vertices[e][1];
+          const double   t = s.d[i] / (s.d[i] - s.d[j]);
+          if (t < 0.02 || t > 0.98)
+            ok = false;
+          s.x[first_copy(e)] = s.x[second_copy(e)] = lerp(X[i], X[j], t);
+        }
+      if (!ok)
+        return false;
+      std::vector<Point> positions;
+      for (const auto &c : corners)
+        positions.push_back(corner_position(c, s));
+      s.corners = corners;
+      sort_corners(s.corners, positions, s.normal);
+      return true;
+    }
+
+
+    /// Adds sample @p s to the complete cut through the @p crossing edges and the
+    /// @p zmask vertices.
+    void
+    add_complete_sample(std::map<Key, Configuration> &configurations,
+                        const unsigned                crossing,
+                        const unsigned                zmask,
+                        const Sample                 &s)
+    {
+      const Key key = make_key(crossing, zmask, 0);
+      auto     &cfg = configurations[key];
+      cfg.kind      = CutKind::complete;
+      cfg.edges     = static_cast<std::uint8_t>(crossing);
+      cfg.vertices  = static_cast<std::uint8_t>(zmask);
+      cfg.name      = std::string(s.corners.size() == 3 ? "A" : "B")
+                 + std::string(popcount(zmask) >= 1 ? "-v" : "")
+                 + std::string(popcount(zmask) >= 2 ? "v" : "");
+      cfg.samples.push_back(s);
+    }
+
+
+    /// Adds the partial cuts of section @p s (whose vertices on the plane are
+    /// @p zmask): every crack that is a run of consecutive corners reaching all those
+    /// vertices, with the front crossing the two section sides that leave the run.
+    void
+    add_partial_samples(std::map<Key, Configuration> &configurations,
+                        const unsigned                zmask,
+                        const Sample                 &s,
+                        std::mt19937                 &rng)
+    {
+      std::uniform_real_distribution<double> param(0.02, 0.98);
+      const auto                            &ring = s.corners;
+      const unsigned                         m    = static_cast<unsigned>(ring.size());
+      for (unsigned start = 0; start < m; ++start)
+        for (unsigned length_run = 1; length_run < m; ++length_run)
+        {
+          std::vector<Corner> run;
+          unsigned            run_edges = 0, run_vertices = 0;
+          for (unsigned k = 0; k < length_run; ++k)
+          {
+            const Corner &c = ring[(start + k) % m];
+            run.push_back(c);
+            (c.is_vertex ? run_vertices : run_edges) |= 1u << c.index;
+          }
+          if (run_vertices != zmask)
+            continue; // a vertex on the plane that the crack does not reach
+          const Corner &last     = run.back();
+          const Corner &next     = ring[(start + length_run) % m];
+          const Corner &first    = run.front();
+          const Corner &before   = ring[(start + m - 1) % m];
+          const auto    faces_of = [](const Corner &c)
+          { return c.is_vertex ? faces_of_vertex(c.index) : faces_of_edge(c.index); };
+          const unsigned f_after  = faces_of(last) & faces_of(next);
+          const unsigned f_before = faces_of(before) & faces_of(first);
+          if (popcount(f_after) != 1 || popcount(f_before) != 1 || f_after == f_before)
+            continue;
+          Sample      p        = s;
+          const Point a_last   = corner_position(last, s),
+                      a_next   = corner_position(next, s);
+          const Point a_first  = corner_position(first, s),
+                      a_before = corner_position(before, s);
+          unsigned fa = 0, fb = 0;
+          while (!(f_after & (1u << fa)))
+            ++fa;
+          while (!(f_before & (1u << fb)))
+            ++fb;
+          p.x[face_node(fa)] = lerp(a_last, a_next, param(rng));
+          p.x[face_node(fb)] = lerp(a_first, a_before, param(rng));
+          // Crack polygon: the run, then the two front points.
+          p.corners     = run;
+          const Key key = make_key(run_edges, run_vertices, f_after | f_before);
+          auto     &cfg = configurations[key];
+          cfg.kind      = CutKind::partial;
+          cfg.edges     = static_cast<std::uint8_t>(run_edges);
+          cfg.vertices  = static_cast<std::uint8_t>(run_vertices);
+          cfg.faces     = static_cast<std::uint8_t>(f_after | f_before);
+          cfg.name      = std::string(1, static_cast<char>('C' + length_run - 1))
+                     + std::string(popcount(run_vertices) >= 1 ? "-v" : "")
+                     + std::string(popcount(run_vertices) >= 2 ? "v" : "");
+          if (cfg.samples.size() < 48)
+            cfg.samples.push_back(p);
+        }
+    }
+
+
     // Adds the configurations of every planar section of the reference tetrahedron: for
     // each pattern of vertex sides (+, -, or on the plane), random planes realising it,
     // the complete cut and every partial cut whose crack is a run of consecutive section
@@ -146,195 +353,44 @@ namespace lacerta::cut
     void
     enumerate_sections(std::map<Key, Configuration> &configurations, std::mt19937 &rng)
     {
-      const auto                             X = reference_tetrahedron();
-      std::uniform_real_distribution<double> param(0.02, 0.98);
-
       for (unsigned code = 0; code < 81; ++code)
       {
-        std::array<int, 4> side;
-        for (unsigned v = 0, c = code; v < 4; ++v, c /= 3)
-          side[v] = static_cast<int>(c % 3) - 1;
-        unsigned zmask = 0, pmask = 0, nmask = 0;
-        for (unsigned v = 0; v < 4; ++v)
-          (side[v] == 0 ? zmask : (side[v] > 0 ? pmask : nmask)) |= 1u << v;
+        const SidePattern pattern = side_pattern(code);
         // Each pattern once up to a global flip: the lowest off-plane vertex is +.
-        const unsigned off = pmask | nmask;
+        const unsigned off = pattern.pmask | pattern.nmask;
         if (off == 0)
           continue;
         const unsigned lowest = off & (~off + 1);
-        if (!(pmask & lowest))
+        if (!(pattern.pmask & lowest))
           continue;
-
-        if (nmask == 0)
+        if (pattern.nmask == 0)
         {
-          // The plane touches the tetrahedron at the vertices in zmask, or misses it.
-          const Key key = make_key(0, zmask, 0);
-          auto     &cfg = configurations[key];
-          if (cfg.samples.empty())
-          {
-            const unsigned n = popcount(zmask);
-            cfg.kind         = n == 0 ? CutKind::none : CutKind::touch;
-            cfg.vertices     = static_cast<std::uint8_t>(zmask);
-            cfg.name =
-              n == 0 ? "none" : (n == 1 ? "touch-v" : (n == 2 ? "touch-e" : "touch-f"));
-            Sample s;
-            for (unsigned v = 0; v < 4; ++v)
-              s.x[v] = X[v];
-            cfg.samples.push_back(s);
-          }
+          add_touch_configuration(configurations, pattern.zmask);
           continue;
         }
-
         unsigned crossing = 0;
         for (unsigned e = 0; e < 6; ++e)
         {
           const unsigned i = tet_edge_vertices[e][0], j = tet_edge_vertices[e][1];
-          if (side[i] * side[j] < 0)
+          if (pattern.side[i] * pattern.side[j] < 0)
             crossing |= 1u << e;
         }
-
         std::vector<Corner> corners;
         for (unsigned v = 0; v < 4; ++v)
-          if (zmask & (1u << v))
+          if (pattern.zmask & (1u << v))
             corners.push_back({true, v});
         for (unsigned e = 0; e < 6; ++e)
           if (crossing & (1u << e))
             corners.push_back({false, e});
-
         unsigned n_planes = 0;
         for (unsigned attempt = 0; attempt < 2000 && n_planes < 24; ++attempt)
         {
-          // The plane through three corners (vertices, or random points on edges).
           Sample s;
-          for (unsigned v = 0; v < 4; ++v)
-            s.x[v] = X[v];
-          std::array<Point, 3> through;
-          for (unsigned k = 0; k < 3; ++k)
-          {
-            const Corner &c = corners[k];
-            if (c.is_vertex)
-              through[k] = X[c.index];
-            else
-            {
-              const unsigned i = tet_edge_vertices[c.index][0],
-                             j = tet_edge_vertices[c.index][1];
-              through[k]       = lerp(X[i], X[j], param(rng));
-            }
-          }
-          Point normal = cross(sub(through[1], through[0]), sub(through[2], through[0]));
-          const double length = norm(normal);
-          if (length < 1e-6)
-            continue;
-          normal      = scale(1.0 / length, normal);
-          s.origin    = through[0];
-          bool   ok   = true;
-          double flip = 0;
-          for (unsigned v = 0; v < 4; ++v)
-          {
-            s.d[v] = dot(normal, sub(X[v], s.origin));
-            if (side[v] == 0)
-            {
-              s.d[v] = 0;
-              continue;
-            }
-            if (std::abs(s.d[v]) < 1e-3)
-              ok = false;
-            const double f = s.d[v] * side[v] > 0 ? 1 : -1;
-            if (flip == 0)
-              flip = f;
-            else if (flip != f)
-              ok = false;
-          }
-          if (!ok)
-            continue;
-          // Orient the normal towards the pattern's + side.
-          s.normal = scale(flip, normal);
-          for (unsigned v = 0; v < 4; ++v)
-            s.d[v] *= flip;
-          for (unsigned e = 0; e < 6; ++e)
-            if (crossing & (1u << e))
-            {
-              const unsigned i = tet_edge_vertices[e][0], j = tet_edge_vertices[e][1];
-              const double   t = s.d[i] / (s.d[i] - s.d[j]);
-              if (t < 0.02 || t > 0.98)
-                ok = false;
-              s.x[first_copy(e)] = s.x[second_copy(e)] = lerp(X[i], X[j], t);
-            }
-          if (!ok)
+          if (!random_section(pattern, corners, crossing, rng, s))
             continue;
           ++n_planes;
-
-          std::vector<Point> positions;
-          for (const auto &c : corners)
-            positions.push_back(corner_position(c, s));
-          s.corners = corners;
-          sort_corners(s.corners, positions, s.normal);
-
-          {
-            const Key key = make_key(crossing, zmask, 0);
-            auto     &cfg = configurations[key];
-            cfg.kind      = CutKind::complete;
-            cfg.edges     = static_cast<std::uint8_t>(crossing);
-            cfg.vertices  = static_cast<std::uint8_t>(zmask);
-            cfg.name      = std::string(corners.size() == 3 ? "A" : "B")
-                       + std::string(popcount(zmask) >= 1 ? "-v" : "")
-                       + std::string(popcount(zmask) >= 2 ? "v" : "");
-            cfg.samples.push_back(s);
-          }
-
-          // Partial cuts: the crack is a run of consecutive corners.
-          const auto    &ring = s.corners;
-          const unsigned m    = static_cast<unsigned>(ring.size());
-          for (unsigned start = 0; start < m; ++start)
-            for (unsigned length_run = 1; length_run < m; ++length_run)
-            {
-              std::vector<Corner> run;
-              unsigned            run_edges = 0, run_vertices = 0;
-              for (unsigned k = 0; k < length_run; ++k)
-              {
-                const Corner &c = ring[(start + k) % m];
-                run.push_back(c);
-                (c.is_vertex ? run_vertices : run_edges) |= 1u << c.index;
-              }
-              if (run_vertices != zmask)
-                continue; // a vertex on the plane that the crack does not reach
-              const Corner &last     = run.back();
-              const Corner &next     = ring[(start + length_run) % m];
-              const Corner &first    = run.front();
-              const Corner &before   = ring[(start + m - 1) % m];
-              const auto    faces_of = [](const Corner &c)
-              { return c.is_vertex ? faces_of_vertex(c.index) : faces_of_edge(c.index); };
-              const unsigned f_after  = faces_of(last) & faces_of(next);
-              const unsigned f_before = faces_of(before) & faces_of(first);
-              if (popcount(f_after) != 1 || popcount(f_before) != 1
-                  || f_after == f_before)
-                continue;
-              Sample      p        = s;
-              const Point a_last   = corner_position(last, s),
-                          a_next   = corner_position(next, s);
-              const Point a_first  = corner_position(first, s),
-                          a_before = corner_position(before, s);
-              unsigned fa = 0, fb = 0;
-              while (!(f_after & (1u << fa)))
-                ++fa;
-              while (!(f_before & (1u << fb)))
-                ++fb;
-              p.x[face_node(fa)] = lerp(a_last, a_next, param(rng));
-              p.x[face_node(fb)] = lerp(a_first, a_before, param(rng));
-              // Crack polygon: the run, then the two front points.
-              p.corners     = run;
-              const Key key = make_key(run_edges, run_vertices, f_after | f_before);
-              auto     &cfg = configurations[key];
-              cfg.kind      = CutKind::partial;
-              cfg.edges     = static_cast<std::uint8_t>(run_edges);
-              cfg.vertices  = static_cast<std::uint8_t>(run_vertices);
-              cfg.faces     = static_cast<std::uint8_t>(f_after | f_before);
-              cfg.name      = std::string(1, static_cast<char>('C' + length_run - 1))
-                         + std::string(popcount(run_vertices) >= 1 ? "-v" : "")
-                         + std::string(popcount(run_vertices) >= 2 ? "v" : "");
-              if (cfg.samples.size() < 48)
-                cfg.samples.push_back(p);
-            }
+          add_complete_sample(configurations, crossing, pattern.zmask, s);
+          add_partial_samples(configurations, pattern.zmask, s, rng);
         }
         if (n_planes == 0)
           throw std::logic_error("split table: no plane realises a side pattern");
@@ -661,6 +717,237 @@ namespace lacerta::cut
       return mask;
     }
 
+    /// What the entries of one configuration are built from (build_configuration()):
+    /// the table they go into, the configuration and its key, the problem its pieces
+    /// start from (the samples and the planes' masks) and its face triangulations.
+    struct EntryBuild
+    {
+      Table                     &table;
+      const Configuration       &cfg;
+      Key                        key;
+      PieceProblem               base;
+      std::vector<PieceTriangle> faces;
+
+      /// The sample the pieces are built on.
+      const Sample &
+      sample() const
+      {
+        return cfg.samples.front();
+      }
+    };
+
+
+    /// The entry of a configuration that leaves the tetrahedron whole (none, touch).
+    void
+    add_whole_entry(const EntryBuild &b)
+    {
+      add_entry(b.table,
+                b.cfg,
+                b.key,
+                {{PieceTetrahedron{0, 1, 2, 3}}},
+                {0xFu & ~b.cfg.vertices},
+                b.base.plane_mask,
+                0,
+                {},
+                0);
+    }
+
+
+    /// The entry of a conforming refinement through the cut points (nothing
+    /// separated).
+    void
+    add_refinement_entry(const EntryBuild &b)
+    {
+      PieceProblem problem = b.base;
+      problem.boundary     = b.faces;
+      for (std::uint8_t v = 0; v < 4; ++v)
+        problem.nodes.push_back(v);
+      for (unsigned e = 0; e < 6; ++e)
+        if (b.cfg.edges & (1u << e))
+          problem.nodes.push_back(first_copy(e));
+      const auto    d        = decompose_piece(problem, 12);
+      std::uint32_t interior = 0;
+      if (d.uses_interior_node)
+        for (const auto v : problem.nodes)
+          interior |= 1u << v;
+      add_entry(
+        b.table, b.cfg, b.key, {d.tetrahedra}, {0xF}, b.base.plane_mask, interior, {}, 0);
+    }
+
+
+    /// The entries of a complete cut: two pieces, each decomposed; a quadrilateral
+    /// section has one entry per diagonal.
+    void
+    add_complete_entries(const EntryBuild &b)
+    {
+      const unsigned n_variants = b.sample().corners.size() == 4 ? 2 : 1;
+      std::uint16_t  first      = no_entry;
+      for (unsigned variant = 0; variant < n_variants; ++variant)
+      {
+        std::vector<std::vector<PieceTetrahedron>> pieces;
+        std::vector<std::uint32_t>                 piece_vertices;
+        std::uint32_t                              interior = 0;
+        for (const int sign : {1, -1})
+        {
+          PieceProblem  problem  = b.base;
+          std::uint32_t vertices = 0;
+          for (std::uint8_t v = 0; v < 4; ++v)
+            if (b.sample().d[v] * sign > 0 || b.sample().d[v] == 0)
+            {
+              problem.nodes.push_back(v);
+              if (b.sample().d[v] != 0)
+                vertices |= 1u << v;
+            }
+          for (unsigned e = 0; e < 6; ++e)
+            if (b.cfg.edges & (1u << e))
+              problem.nodes.push_back(corner_node({false, e}, b.sample(), sign));
+          const auto in_piece = [&](const std::uint8_t id)
+          {
+            return std::find(problem.nodes.begin(), problem.nodes.end(), id)
+                   != problem.nodes.end();
+          };
+          for (const auto &t : b.faces)
+            if (in_piece(t[0]) && in_piece(t[1]) && in_piece(t[2]))
+              problem.boundary.push_back(t);
+          // The cut polygon, facing this piece.
+          std::vector<std::uint8_t> c;
+          for (const auto &corner : b.sample().corners)
+            c.push_back(corner_node(corner, b.sample(), sign));
+          std::vector<std::array<unsigned, 3>> tri;
+          if (c.size() == 3)
+            tri = {{0, 1, 2}};
+          else if (variant == 0)
+            tri = {{0, 1, 2}, {0, 2, 3}};
+          else
+            tri = {{1, 2, 3}, {1, 3, 0}};
+          for (const auto &t : tri)
+            problem.boundary.push_back(sign > 0
+                                         ? PieceTriangle{c[t[0]], c[t[1]], c[t[2]]}
+                                         : PieceTriangle{c[t[0]], c[t[2]], c[t[1]]});
+          const auto d = decompose_piece(problem, 12);
+          if (d.uses_interior_node)
+          {
+            if (interior != 0)
+              throw std::logic_error("split table: two interior points in " + b.cfg.name);
+            for (const auto v : problem.nodes)
+              interior |= 1u << v;
+          }
+          pieces.push_back(d.tetrahedra);
+          piece_vertices.push_back(vertices);
+        }
+        std::array<std::uint8_t, 4> quad{};
+        for (std::size_t k = 0; k < b.sample().corners.size() && k < 4; ++k)
+          quad[k] = static_cast<std::uint8_t>(b.sample().corners[k].index);
+        add_entry(b.table,
+                  b.cfg,
+                  variant == 0 ? b.key : no_entry,
+                  pieces,
+                  piece_vertices,
+                  b.base.plane_mask,
+                  interior,
+                  quad,
+                  static_cast<std::uint8_t>(variant));
+        if (variant == 0)
+          first = static_cast<std::uint16_t>(b.table.entries.size() - 1);
+        else
+          b.table.entries[first].alternate =
+            static_cast<std::uint16_t>(b.table.entries.size() - 1);
+      }
+    }
+
+
+    /// The entry of a partial cut: one piece, slit along the crack.
+    void
+    add_partial_entry(const EntryBuild &b)
+    {
+      // Partial: one piece, the tetrahedron slit along the crack polygon (the run of
+      // corners and the two front points). The crack is internal, so every triangulation
+      // of it is tried.
+      std::vector<std::uint8_t> front;
+      for (unsigned f = 0; f < 4; ++f)
+        if (b.cfg.faces & (1u << f))
+          front.push_back(face_node(f));
+      // Order the crack polygon counter-clockwise around the normal: the run is already
+      // in order; the front points follow the run's last corner.
+      const Corner  &last = b.sample().corners.back();
+      const unsigned last_faces =
+        last.is_vertex ? faces_of_vertex(last.index) : faces_of_edge(last.index);
+      std::uint8_t after = front[0], before = front[1];
+      if (b.sample().corners.size() == 1)
+      {
+        // One corner: orient by geometry.
+        const Point a = corner_position(last, b.sample());
+        if (dot(b.sample().normal,
+                cross(sub(b.sample().x[front[0]], a), sub(b.sample().x[front[1]], a)))
+            < 0)
+          std::swap(after, before);
+      }
+      else if (!(last_faces & (1u << (after - 16))))
+        std::swap(after, before);
+
+      PieceProblem problem = b.base;
+      for (std::uint8_t v = 0; v < 4; ++v)
+        problem.nodes.push_back(v);
+      for (unsigned e = 0; e < 6; ++e)
+        if (b.cfg.edges & (1u << e))
+        {
+          problem.nodes.push_back(first_copy(e));
+          problem.nodes.push_back(second_copy(e));
+        }
+      problem.nodes.push_back(front[0]);
+      problem.nodes.push_back(front[1]);
+
+      std::vector<std::uint8_t> plus, minus;
+      for (const auto &corner : b.sample().corners)
+      {
+        plus.push_back(corner_node(corner, b.sample(), 1));
+        minus.push_back(corner_node(corner, b.sample(), -1));
+      }
+      plus.push_back(after);
+      plus.push_back(before);
+      minus.push_back(after);
+      minus.push_back(before);
+      // Check the crack polygon really is counter-clockwise around the normal.
+      {
+        Point area{0, 0, 0};
+        for (std::size_t k = 0; k < plus.size(); ++k)
+          area =
+            add(area,
+                cross(b.sample().x[plus[k]], b.sample().x[plus[(k + 1) % plus.size()]]));
+        if (dot(area, b.sample().normal) <= 0)
+          throw std::logic_error("split table: crack polygon orientation in "
+                                 + b.cfg.name);
+      }
+
+      std::optional<std::vector<PieceTetrahedron>> best;
+      for (const auto &tri : polygon_triangulations(static_cast<unsigned>(plus.size())))
+      {
+        PieceProblem p = problem;
+        p.boundary     = b.faces;
+        for (const auto &t : tri)
+        {
+          p.boundary.push_back({plus[t[0]], plus[t[1]], plus[t[2]]});
+          p.boundary.push_back({minus[t[0]], minus[t[2]], minus[t[1]]});
+        }
+        const unsigned limit = best ? static_cast<unsigned>(best->size()) - 1 : 12;
+        if (auto tets = minimal_tetrahedralization(p, limit))
+          best = std::move(tets);
+      }
+      if (!best)
+        throw std::logic_error("split table: no decomposition for partial case "
+                               + b.cfg.name);
+      add_entry(b.table,
+                b.cfg,
+                b.key,
+                {*best},
+                {0xFu & ~b.cfg.vertices},
+                b.base.plane_mask,
+                0,
+                {},
+                0);
+    }
+
+
     void
     build_configuration(Table &table, const Configuration &cfg, const Key key)
     {
@@ -673,193 +960,26 @@ namespace lacerta::cut
         if (face_triangles(cfg, s, copies) != faces)
           throw std::logic_error("split table: face triangulation varies in " + cfg.name);
 
-      PieceProblem base;
-      base.plane_mask = mask;
+      EntryBuild b{table, cfg, key, {}, faces};
+      b.base.plane_mask = mask;
       for (const auto &s : cfg.samples)
-        base.samples.push_back(s.x);
+        b.base.samples.push_back(s.x);
 
-      if (cfg.kind == CutKind::none || cfg.kind == CutKind::touch)
+      switch (cfg.kind)
       {
-        add_entry(table,
-                  cfg,
-                  key,
-                  {{PieceTetrahedron{0, 1, 2, 3}}},
-                  {0xFu & ~cfg.vertices},
-                  mask,
-                  0,
-                  {},
-                  0);
-        return;
+        case CutKind::none:
+        case CutKind::touch:
+          add_whole_entry(b);
+          break;
+        case CutKind::refinement:
+          add_refinement_entry(b);
+          break;
+        case CutKind::complete:
+          add_complete_entries(b);
+          break;
+        default:
+          add_partial_entry(b);
       }
-
-      if (cfg.kind == CutKind::refinement)
-      {
-        PieceProblem problem = base;
-        problem.boundary     = faces;
-        for (std::uint8_t v = 0; v < 4; ++v)
-          problem.nodes.push_back(v);
-        for (unsigned e = 0; e < 6; ++e)
-          if (cfg.edges & (1u << e))
-            problem.nodes.push_back(first_copy(e));
-        const auto    d        = decompose_piece(problem, 12);
-        std::uint32_t interior = 0;
-        if (d.uses_interior_node)
-          for (const auto v : problem.nodes)
-            interior |= 1u << v;
-        add_entry(table, cfg, key, {d.tetrahedra}, {0xF}, mask, interior, {}, 0);
-        return;
-      }
-
-      if (cfg.kind == CutKind::complete)
-      {
-        const unsigned n_variants = s0.corners.size() == 4 ? 2 : 1;
-        std::uint16_t  first      = no_entry;
-        for (unsigned variant = 0; variant < n_variants; ++variant)
-        {
-          std::vector<std::vector<PieceTetrahedron>> pieces;
-          std::vector<std::uint32_t>                 piece_vertices;
-          std::uint32_t                              interior = 0;
-          for (const int sign : {1, -1})
-          {
-            PieceProblem  problem  = base;
-            std::uint32_t vertices = 0;
-            for (std::uint8_t v = 0; v < 4; ++v)
-              if (s0.d[v] * sign > 0 || s0.d[v] == 0)
-              {
-                problem.nodes.push_back(v);
-                if (s0.d[v] != 0)
-                  vertices |= 1u << v;
-              }
-            for (unsigned e = 0; e < 6; ++e)
-              if (cfg.edges & (1u << e))
-                problem.nodes.push_back(corner_node({false, e}, s0, sign));
-            const auto in_piece = [&](const std::uint8_t id)
-            {
-              return std::find(problem.nodes.begin(), problem.nodes.end(), id)
-                     != problem.nodes.end();
-            };
-            for (const auto &t : faces)
-              if (in_piece(t[0]) && in_piece(t[1]) && in_piece(t[2]))
-                problem.boundary.push_back(t);
-            // The cut polygon, facing this piece.
-            std::vector<std::uint8_t> c;
-            for (const auto &corner : s0.corners)
-              c.push_back(corner_node(corner, s0, sign));
-            std::vector<std::array<unsigned, 3>> tri;
-            if (c.size() == 3)
-              tri = {{0, 1, 2}};
-            else if (variant == 0)
-              tri = {{0, 1, 2}, {0, 2, 3}};
-            else
-              tri = {{1, 2, 3}, {1, 3, 0}};
-            for (const auto &t : tri)
-              problem.boundary.push_back(sign > 0
-                                           ? PieceTriangle{c[t[0]], c[t[1]], c[t[2]]}
-                                           : PieceTriangle{c[t[0]], c[t[2]], c[t[1]]});
-            const auto d = decompose_piece(problem, 12);
-            if (d.uses_interior_node)
-            {
-              if (interior != 0)
-                throw std::logic_error("split table: two interior points in " + cfg.name);
-              for (const auto v : problem.nodes)
-                interior |= 1u << v;
-            }
-            pieces.push_back(d.tetrahedra);
-            piece_vertices.push_back(vertices);
-          }
-          std::array<std::uint8_t, 4> quad{};
-          for (std::size_t k = 0; k < s0.corners.size() && k < 4; ++k)
-            quad[k] = static_cast<std::uint8_t>(s0.corners[k].index);
-          add_entry(table,
-                    cfg,
-                    variant == 0 ? key : no_entry,
-                    pieces,
-                    piece_vertices,
-                    mask,
-                    interior,
-                    quad,
-                    static_cast<std::uint8_t>(variant));
-          if (variant == 0)
-            first = static_cast<std::uint16_t>(table.entries.size() - 1);
-          else
-            table.entries[first].alternate =
-              static_cast<std::uint16_t>(table.entries.size() - 1);
-        }
-        return;
-      }
-
-      // Partial: one piece, the tetrahedron slit along the crack polygon (the run of
-      // corners and the two front points). The crack is internal, so every triangulation
-      // of it is tried.
-      std::vector<std::uint8_t> front;
-      for (unsigned f = 0; f < 4; ++f)
-        if (cfg.faces & (1u << f))
-          front.push_back(face_node(f));
-      // Order the crack polygon counter-clockwise around the normal: the run is already
-      // in order; the front points follow the run's last corner.
-      const Corner  &last = s0.corners.back();
-      const unsigned last_faces =
-        last.is_vertex ? faces_of_vertex(last.index) : faces_of_edge(last.index);
-      std::uint8_t after = front[0], before = front[1];
-      if (s0.corners.size() == 1)
-      {
-        // One corner: orient by geometry.
-        const Point a = corner_position(last, s0);
-        if (dot(s0.normal, cross(sub(s0.x[front[0]], a), sub(s0.x[front[1]], a))) < 0)
-          std::swap(after, before);
-      }
-      else if (!(last_faces & (1u << (after - 16))))
-        std::swap(after, before);
-
-      PieceProblem problem = base;
-      for (std::uint8_t v = 0; v < 4; ++v)
-        problem.nodes.push_back(v);
-      for (unsigned e = 0; e < 6; ++e)
-        if (cfg.edges & (1u << e))
-        {
-          problem.nodes.push_back(first_copy(e));
-          problem.nodes.push_back(second_copy(e));
-        }
-      problem.nodes.push_back(front[0]);
-      problem.nodes.push_back(front[1]);
-
-      std::vector<std::uint8_t> plus, minus;
-      for (const auto &corner : s0.corners)
-      {
-        plus.push_back(corner_node(corner, s0, 1));
-        minus.push_back(corner_node(corner, s0, -1));
-      }
-      plus.push_back(after);
-      plus.push_back(before);
-      minus.push_back(after);
-      minus.push_back(before);
-      // Check the crack polygon really is counter-clockwise around the normal.
-      {
-        Point area{0, 0, 0};
-        for (std::size_t k = 0; k < plus.size(); ++k)
-          area = add(area, cross(s0.x[plus[k]], s0.x[plus[(k + 1) % plus.size()]]));
-        if (dot(area, s0.normal) <= 0)
-          throw std::logic_error("split table: crack polygon orientation in " + cfg.name);
-      }
-
-      std::optional<std::vector<PieceTetrahedron>> best;
-      for (const auto &tri : polygon_triangulations(static_cast<unsigned>(plus.size())))
-      {
-        PieceProblem p = problem;
-        p.boundary     = faces;
-        for (const auto &t : tri)
-        {
-          p.boundary.push_back({plus[t[0]], plus[t[1]], plus[t[2]]});
-          p.boundary.push_back({minus[t[0]], minus[t[2]], minus[t[1]]});
-        }
-        const unsigned limit = best ? static_cast<unsigned>(best->size()) - 1 : 12;
-        if (auto tets = minimal_tetrahedralization(p, limit))
-          best = std::move(tets);
-      }
-      if (!best)
-        throw std::logic_error("split table: no decomposition for partial case "
-                               + cfg.name);
-      add_entry(table, cfg, key, {*best}, {0xFu & ~cfg.vertices}, mask, 0, {}, 0);
     }
 
     void
@@ -1115,162 +1235,194 @@ namespace lacerta::cut
   }
 
 
-  CutKind
-  split_tetrahedron(const TetCut &cut, SplitResult &result, const double snap_fraction)
+  namespace
   {
-    if (!(snap_fraction > 0 && snap_fraction < 0.5))
-      throw std::invalid_argument(
-        "split_tetrahedron: the snap fraction must lie in (0, 0.5)");
-    const Table &T   = table();
-    const auto  &ids = cut.vertex_ids;
-
-    // The canonical frame: canonical vertex k is the local vertex with the k-th smallest
-    // global id. All diagonal decisions depend on this order only.
-    unsigned ranks = 0;
-    for (unsigned i = 0; i < 4; ++i)
+    /// The permutation to the canonical frame of a tetrahedron with vertex ids
+    /// @p ids: canonical vertex k is the local vertex with the k-th smallest global id
+    /// (every diagonal decision depends on this order only).
+    inline const Permutation &
+    canonical_frame(const Table &T, const std::array<VertexId, 4> &ids)
     {
-      const unsigned r =
-        (ids[0] < ids[i]) + (ids[1] < ids[i]) + (ids[2] < ids[i]) + (ids[3] < ids[i]);
-      ranks |= r << (2 * i);
-    }
-    const unsigned perm_index = T.permutation_of_ranks[ranks];
-    if (perm_index == 0xFF)
-      throw std::invalid_argument("split_tetrahedron: vertex ids are not distinct");
-    const Permutation &P = T.permutations[perm_index];
-
-    unsigned plus = 0, minus = 0, on_cut = 0;
-    for (unsigned v = 0; v < 4; ++v)
-    {
-      const int s = cut.vertex_side[v];
-      (s > 0 ? plus : (s < 0 ? minus : on_cut)) |= 1u << v;
-    }
-    const unsigned crossing = T.crossing_edges[plus | (minus << 4)];
-    const unsigned edges    = cut.cut_edges & 0x3Fu;
-    const unsigned key =
-      P.edges_to_canonical[edges]
-      | (static_cast<unsigned>(P.vertices_to_canonical[on_cut]) << 6)
-      | (static_cast<unsigned>(P.vertices_to_canonical[cut.front_faces & 0xFu]) << 10);
-
-    std::uint16_t index = T.entry_of_key[key];
-    bool          valid = index != no_entry;
-    if (valid)
-    {
-      switch (T.entries[index].kind)
+      unsigned ranks = 0;
+      for (unsigned i = 0; i < 4; ++i)
       {
-        case CutKind::complete:
-          valid = crossing == edges;
-          break;
-        case CutKind::partial:
-          valid = (edges & ~crossing) == 0;
-          break;
-        case CutKind::touch:
-          valid = crossing == 0 && edges == 0;
-          break;
-        default:
-          break;
+        const unsigned r =
+          (ids[0] < ids[i]) + (ids[1] < ids[i]) + (ids[2] < ids[i]) + (ids[3] < ids[i]);
+        ranks |= r << (2 * i);
       }
+      const unsigned perm_index = T.permutation_of_ranks[ranks];
+      if (perm_index == 0xFF)
+        throw std::invalid_argument("split_tetrahedron: vertex ids are not distinct");
+      return T.permutations[perm_index];
     }
-    if (!valid)
+
+
+    /// The table entry for @p cut in frame @p P, whose vertices on the + and - sides
+    /// and on the cut are @p plus, @p minus and @p on_cut: the entry of its cut edges,
+    /// vertices on the cut and front faces if they describe a cut that the sides
+    /// allow, else the refinement through its cut edges; no_entry if front faces do
+    /// not describe a partial cut.
+    inline std::uint16_t
+    find_entry(const Table       &T,
+               const Permutation &P,
+               const TetCut      &cut,
+               const unsigned     plus,
+               const unsigned     minus,
+               const unsigned     on_cut)
     {
+      const unsigned crossing = T.crossing_edges[plus | (minus << 4)];
+      const unsigned edges    = cut.cut_edges & 0x3Fu;
+      const unsigned key =
+        P.edges_to_canonical[edges]
+        | (static_cast<unsigned>(P.vertices_to_canonical[on_cut]) << 6)
+        | (static_cast<unsigned>(P.vertices_to_canonical[cut.front_faces & 0xFu]) << 10);
+      const std::uint16_t index = T.entry_of_key[key];
+      bool                valid = index != no_entry;
+      if (valid)
+      {
+        switch (T.entries[index].kind)
+        {
+          case CutKind::complete:
+            valid = crossing == edges;
+            break;
+          case CutKind::partial:
+            valid = (edges & ~crossing) == 0;
+            break;
+          case CutKind::touch:
+            valid = crossing == 0 && edges == 0;
+            break;
+          default:
+            break;
+        }
+      }
+      if (valid)
+        return index;
       if (cut.front_faces != 0)
-      {
-        result.kind       = CutKind::unsupported;
-        result.n_children = 0;
-        return result.kind;
-      }
-      index = T.refinement_entry[P.edges_to_canonical[edges]];
+        return no_entry;
+      return T.refinement_entry[P.edges_to_canonical[edges]];
     }
 
-    // New point positions, computed from the endpoint with the smaller id so that
-    // neighbours sharing the edge get bit-identical points.
-    const double eps = snap_fraction;
-    for (unsigned e = 0; e < 6; ++e)
-      if (edges & (1u << e))
-      {
-        unsigned a = tet_edge_vertices[e][0], b = tet_edge_vertices[e][1];
-        if (ids[b] < ids[a])
-          std::swap(a, b);
-        const double t = std::min(std::max(cut.edge_parameter[e], eps), 1.0 - eps);
-        for (unsigned k = 0; k < 3; ++k)
-          result.edge_points[e][k] =
-            cut.points[a][k] + t * (cut.points[b][k] - cut.points[a][k]);
-      }
-    for (unsigned f = 0; f < 4; ++f)
-      if (cut.front_faces & (1u << f))
-        result.face_points[f] = cut.front_points[f];
 
-    const TableEntry *entry = &T.entries[index];
-    if (entry->alternate != no_entry)
+    /// The new points' positions: cut points clamped to [ε, 1 - ε] from the endpoint
+    /// with the smaller id (so that neighbours sharing the edge get bit-identical
+    /// points), and the front points.
+    inline void
+    place_new_points(const TetCut &cut, const double eps, SplitResult &result)
     {
-      // Case B: the cut quadrilateral is internal to this tetrahedron, so its diagonal
-      // may be chosen by geometry. The diagonal is the only edge the two choices do not
-      // share, and short edges limit the stable time step: take the longer one. (In a
-      // sliver two opposite corners can almost coincide.)
+      const auto    &ids   = cut.vertex_ids;
+      const unsigned edges = cut.cut_edges & 0x3Fu;
+      for (unsigned e = 0; e < 6; ++e)
+        if (edges & (1u << e))
+        {
+          unsigned a = tet_edge_vertices[e][0], b = tet_edge_vertices[e][1];
+          if (ids[b] < ids[a])
+            std::swap(a, b);
+          const double t = std::min(std::max(cut.edge_parameter[e], eps), 1.0 - eps);
+          for (unsigned k = 0; k < 3; ++k)
+            result.edge_points[e][k] =
+              cut.points[a][k] + t * (cut.points[b][k] - cut.points[a][k]);
+        }
+      for (unsigned f = 0; f < 4; ++f)
+        if (cut.front_faces & (1u << f))
+          result.face_points[f] = cut.front_points[f];
+    }
+
+
+    /// Entry @p index, or for case B its alternate when that has the longer diagonal:
+    /// the cut quadrilateral is internal to the tetrahedron, so its diagonal may be
+    /// chosen by geometry. The diagonal is the only edge the two choices do not share,
+    /// and short edges limit the stable time step. (In a sliver two opposite corners
+    /// can almost coincide.)
+    inline std::uint16_t
+    choose_diagonal(const Table        &T,
+                    const Permutation  &P,
+                    const std::uint16_t index,
+                    const SplitResult  &result)
+    {
+      const TableEntry &entry = T.entries[index];
+      if (entry.alternate == no_entry)
+        return index;
       std::array<Point, 4> q;
       for (unsigned k = 0; k < 4; ++k)
       {
-        const unsigned local = P.node_to_local[first_copy(entry->quad[k])];
+        const unsigned local = P.node_to_local[first_copy(entry.quad[k])];
         q[k]                 = result.edge_points[(local - 4) % 6];
       }
-      if (squared_distance(q[1], q[3]) > squared_distance(q[0], q[2]))
-        index = entry->alternate;
+      return squared_distance(q[1], q[3]) > squared_distance(q[0], q[2]) ? entry.alternate
+                                                                         : index;
     }
-    entry = &T.entries[index];
 
-    const double volume6 =
-      signed_volume6(cut.points[0], cut.points[1], cut.points[2], cut.points[3]);
-    const bool flip = (volume6 < 0) != P.odd;
-    const bool separates =
-      entry->kind == CutKind::complete || entry->kind == CutKind::partial;
 
-    result.kind       = entry->kind;
-    result.entry      = index;
-    result.n_children = entry->n_children;
-
-    // The side every local node id takes, without branching per node: a separated edge
-    // point takes the side of the endpoint its copy belongs to; a vertex on the cut
-    // takes the side of its child (multiplier 1); everything else 0.
-    std::array<std::int8_t, n_node_ids> base{}, on_cut_multiplier{};
-    if (separates)
+    /// The children of @p entry in the local frame of @p cut (through @p P), with the
+    /// sides of their nodes and of themselves, positively oriented (@p flip: the
+    /// parent's orientation reverses the table's).
+    inline void
+    emit_children(const Table       &T,
+                  const Permutation &P,
+                  const TableEntry  &entry,
+                  const TetCut      &cut,
+                  const unsigned     plus,
+                  const unsigned     minus,
+                  const bool         flip,
+                  SplitResult       &result)
     {
-      for (unsigned id = 4; id < 16; ++id)
-        base[id] = cut.vertex_side[T.node_vertex[id]];
-      for (unsigned v = 0; v < 4; ++v)
-        on_cut_multiplier[v] = cut.vertex_side[v] == 0;
-    }
-    const TableChild *tc = &T.children[entry->first_child];
-    for (unsigned c = 0; c < entry->n_children; ++c, ++tc)
-    {
-      Child &out = result.children[c];
-      // The child's side from its vertices off the cut (0 if they disagree: only
-      // ahead of a crack front). A child using a separated copy has all of them on the
-      // copy's side.
-      const unsigned m    = P.vertices_to_local[tc->vertex_mask];
-      const int      side = int((m & plus) != 0) - int((m & minus) != 0);
-      out.side            = static_cast<std::int8_t>(side);
-      out.cut_faces       = tc->cut_faces;
-      for (unsigned k = 0; k < 4; ++k)
+      const bool separates =
+        entry.kind == CutKind::complete || entry.kind == CutKind::partial;
+      // The side every local node id takes, without branching per node: a separated
+      // edge point takes the side of the endpoint its copy belongs to; a vertex on the
+      // cut takes the side of its child (multiplier 1); everything else 0.
+      std::array<std::int8_t, n_node_ids> base{}, on_cut_multiplier{};
+      if (separates)
       {
-        const std::uint8_t local = P.node_to_local[tc->nodes[k]];
-        NodeRef            r     = T.node_ref[local];
-        r.side = static_cast<std::int8_t>(base[local] + on_cut_multiplier[local] * side);
-        out.nodes[k] = r;
+        for (unsigned id = 4; id < 16; ++id)
+          base[id] = cut.vertex_side[T.node_vertex[id]];
+        for (unsigned v = 0; v < 4; ++v)
+          on_cut_multiplier[v] = cut.vertex_side[v] == 0;
       }
-      if (flip)
+      const TableChild *tc = &T.children[entry.first_child];
+      for (unsigned c = 0; c < entry.n_children; ++c, ++tc)
       {
-        std::swap(out.nodes[0], out.nodes[1]);
-        out.cut_faces =
-          static_cast<std::uint8_t>((out.cut_faces & 0xCu) | ((out.cut_faces & 1u) << 1)
-                                    | ((out.cut_faces & 2u) >> 1));
+        Child &out = result.children[c];
+        // The child's side from its vertices off the cut (0 if they disagree: only
+        // ahead of a crack front). A child using a separated copy has all of them on
+        // the copy's side.
+        const unsigned m    = P.vertices_to_local[tc->vertex_mask];
+        const int      side = int((m & plus) != 0) - int((m & minus) != 0);
+        out.side            = static_cast<std::int8_t>(side);
+        out.cut_faces       = tc->cut_faces;
+        for (unsigned k = 0; k < 4; ++k)
+        {
+          const std::uint8_t local = P.node_to_local[tc->nodes[k]];
+          NodeRef            r     = T.node_ref[local];
+          r.side =
+            static_cast<std::int8_t>(base[local] + on_cut_multiplier[local] * side);
+          out.nodes[k] = r;
+        }
+        if (flip)
+        {
+          std::swap(out.nodes[0], out.nodes[1]);
+          out.cut_faces =
+            static_cast<std::uint8_t>((out.cut_faces & 0xCu) | ((out.cut_faces & 1u) << 1)
+                                      | ((out.cut_faces & 2u) >> 1));
+        }
       }
     }
 
-    if (entry->interior_mask != 0)
+
+    /// The interior point of @p entry, if its children use one: the centroid of its
+    /// piece's nodes.
+    inline void
+    place_interior_point(const Permutation &P,
+                         const TableEntry  &entry,
+                         const TetCut      &cut,
+                         SplitResult       &result)
     {
+      if (entry.interior_mask == 0)
+        return;
       Point    c{0, 0, 0};
       unsigned n = 0;
       for (unsigned id = 0; id < n_node_ids; ++id)
-        if (entry->interior_mask & (1u << id))
+        if (entry.interior_mask & (1u << id))
         {
           const std::uint8_t local = P.node_to_local[id];
           const Point       &p     = local < 4    ? cut.points[local]
@@ -1281,6 +1433,40 @@ namespace lacerta::cut
         }
       result.interior_point = scale(1.0 / n, c);
     }
+  } // namespace
+
+
+  CutKind
+  split_tetrahedron(const TetCut &cut, SplitResult &result, const double snap_fraction)
+  {
+    if (!(snap_fraction > 0 && snap_fraction < 0.5))
+      throw std::invalid_argument(
+        "split_tetrahedron: the snap fraction must lie in (0, 0.5)");
+    const Table       &T    = table();
+    const Permutation &P    = canonical_frame(T, cut.vertex_ids);
+    unsigned           plus = 0, minus = 0, on_cut = 0;
+    for (unsigned v = 0; v < 4; ++v)
+    {
+      const int s = cut.vertex_side[v];
+      (s > 0 ? plus : (s < 0 ? minus : on_cut)) |= 1u << v;
+    }
+    std::uint16_t index = find_entry(T, P, cut, plus, minus, on_cut);
+    if (index == no_entry)
+    {
+      result.kind       = CutKind::unsupported;
+      result.n_children = 0;
+      return result.kind;
+    }
+    place_new_points(cut, snap_fraction, result);
+    index                   = choose_diagonal(T, P, index, result);
+    const TableEntry &entry = T.entries[index];
+    const double      volume6 =
+      signed_volume6(cut.points[0], cut.points[1], cut.points[2], cut.points[3]);
+    result.kind       = entry.kind;
+    result.entry      = index;
+    result.n_children = entry.n_children;
+    emit_children(T, P, entry, cut, plus, minus, (volume6 < 0) != P.odd, result);
+    place_interior_point(P, entry, cut, result);
     return result.kind;
   }
 } // namespace lacerta::cut
