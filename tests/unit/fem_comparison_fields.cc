@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <sstream>
 #include <string>
+#include <unistd.h>
 #include <vector>
 
 namespace lacerta
@@ -19,7 +20,8 @@ namespace lacerta
   TEST(FemComparisonFields, FilesHoldBothDisplacementsAndTheirDifference)
   {
     const std::filesystem::path directory =
-      std::filesystem::temp_directory_path() / "lacerta_fem_comparison_fields";
+      std::filesystem::temp_directory_path()
+      / ("lacerta_fem_comparison_fields_" + std::to_string(::getpid()));
     std::filesystem::remove_all(directory);
     std::ostringstream scene;
     scene << "include " LACERTA_SCENE_DIR "/square_pull_comparison.prm\n"

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <unistd.h>
 #include <vector>
 
 namespace lacerta
@@ -70,7 +71,8 @@ namespace lacerta
     run_notched_cantilever(const std::string &name, const std::string &model)
     {
       const std::filesystem::path directory =
-        std::filesystem::temp_directory_path() / ("lacerta_notched_" + name);
+        std::filesystem::temp_directory_path()
+        / ("lacerta_notched_" + name + "_" + std::to_string(::getpid()));
       std::filesystem::remove_all(directory);
       test::run_scene_quietly(
         directory.string() + ".prm",

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <unistd.h>
 #include <vector>
 
 namespace lacerta::test_support
@@ -58,7 +59,8 @@ namespace lacerta::test_support
   {
     // The pulling constraint is a named instance: it must be in the file to exist. One
     // file per variant and process: tests run in parallel in one directory.
-    std::string name = "pulled_bar_" + model + "_" + stiffness + "_" + poisson + ".prm";
+    std::string name = "pulled_bar_" + model + "_" + stiffness + "_" + poisson + "_"
+                       + std::to_string(::getpid()) + ".prm";
     for (char &c : name)
       if (c == ' ')
         c = '_';
