@@ -282,6 +282,33 @@ namespace lacerta::physics
   namespace
   {
     /**
+     * Sorts the ids @p ids in increasing order, by digits of 8 bits from the
+     * lowest (a radix sort: a few passes over them instead of a comparison sort's
+     * mispredicted branches), with @p scratch as room. Only the digits below the
+     * largest id are passed over.
+     */
+    void
+    sort_ids(std::vector<unsigned int> &ids, std::vector<unsigned int> &scratch)
+    {
+      unsigned int largest = 0;
+      for (const unsigned int id : ids)
+        largest |= id;
+      scratch.resize(ids.size());
+      for (unsigned int shift = 0; shift < 32 && (largest >> shift) != 0; shift += 8)
+      {
+        std::array<unsigned int, 257> start{};
+        for (const unsigned int id : ids)
+          ++start[((id >> shift) & 0xFFu) + 1];
+        for (unsigned int d = 1; d < 257; ++d)
+          start[d] += start[d - 1];
+        for (const unsigned int id : ids)
+          scratch[start[(id >> shift) & 0xFFu]++] = id;
+        ids.swap(scratch);
+      }
+    }
+
+
+    /**
      * The mass-independent terms of the rows @p rows (distinct) into @p w: the
      * diagonal blocks Σ_e K_e of every row (w.blocks) and ||K_e|| of every spring at a
      * row (w.pair_norm, for w.springs, in spring order), from the springs and the force
@@ -327,7 +354,7 @@ namespace lacerta::physics
         }
       // In spring order, so that the stiffest spring is chosen as gershgorin_terms()
       // chooses it among equals.
-      std::sort(w.springs.begin(), w.springs.end());
+      sort_ids(w.springs, w.sorted_springs);
       for (std::size_t k = 0; k < w.springs.size(); ++k)
         w.spring_of[w.springs[k]] = static_cast<unsigned int>(k);
       w.blocks.assign(rows.size(), std::array<double, 6>{});

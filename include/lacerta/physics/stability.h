@@ -156,8 +156,9 @@ namespace lacerta::physics
     /// The call's mark; an array entry equal to it belongs to the current call.
     unsigned int              stamp = 0;
     std::vector<unsigned int> row_stamp, row_of, spring_stamp, spring_of, tet_stamp;
-    /// The tetrahedra around the rows and the springs at the rows.
-    std::vector<unsigned int>          tets, springs;
+    /// The tetrahedra around the rows and the springs at the rows (and room to sort
+    /// them).
+    std::vector<unsigned int>          tets, springs, sorted_springs;
     std::vector<std::array<double, 6>> blocks;
     std::vector<double>                pair_norm, off_diagonal, stiffest;
     /// The diagonal terms λ_max(Σ_e K_e) / m_i of the rows weighted anew.
