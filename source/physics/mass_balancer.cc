@@ -532,7 +532,6 @@ namespace lacerta::physics
     std::sort(to_check.begin(), to_check.end());
     to_check.erase(std::unique(to_check.begin(), to_check.end()), to_check.end());
     const std::size_t n_changed = to_check.size();
-    const double      tolerance = 1 + 1e-9;
     for (const unsigned int p : to_check)
       touch(system, p);
     seen.resize(system.n_particles(), 0);
@@ -541,7 +540,7 @@ namespace lacerta::physics
     {
       const unsigned int i = to_check[k];
       if (!(system.free[i] > 0)
-          || !(lambda_at_rest(system, i) > tolerance * target_lambda))
+          || !(lambda_at_rest(system, i) > bound_tolerance * target_lambda))
         continue;
       const double need  = row(system, i) / (target_lambda / (1 + 1e-6)) - system.mass[i];
       const double moved = borrow(
@@ -574,11 +573,10 @@ namespace lacerta::physics
   {
     // Whether each particle is above the limit changes only where a mass or a row
     // changed: at the particles checked and those that gave or took back.
-    const double tolerance = 1 + 1e-9;
     for (const unsigned int p : touched)
     {
       const bool above =
-        system.free[p] > 0 && lambda_at_rest(system, p) > tolerance * limit;
+        system.free[p] > 0 && lambda_at_rest(system, p) > bound_tolerance * limit;
       n_unresolved += static_cast<unsigned int>(above) - unresolved[p];
       unresolved[p] = above;
     }

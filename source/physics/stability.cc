@@ -284,17 +284,17 @@ namespace lacerta::physics
     /**
      * Sorts the ids @p ids in increasing order, by digits of 8 bits from the
      * lowest (a radix sort: a few passes over them instead of a comparison sort's
-     * mispredicted branches), with @p scratch as room. Only the digits below the
-     * largest id are passed over.
+     * mispredicted branches), with @p scratch as room. Only the digits up to the
+     * highest bit set in any id are passed over.
      */
     void
     sort_ids(std::vector<unsigned int> &ids, std::vector<unsigned int> &scratch)
     {
-      unsigned int largest = 0;
+      unsigned int bits = 0;
       for (const unsigned int id : ids)
-        largest |= id;
+        bits |= id;
       scratch.resize(ids.size());
-      for (unsigned int shift = 0; shift < 32 && (largest >> shift) != 0; shift += 8)
+      for (unsigned int shift = 0; shift < 32 && (bits >> shift) != 0; shift += 8)
       {
         std::array<unsigned int, 257> start{};
         for (const unsigned int id : ids)

@@ -102,6 +102,10 @@ namespace lacerta::physics
     /// shorter at most, under the 1.5 times the cost per tetrahedron a cut may add.
     static constexpr double donor_headroom = 2.0;
 
+    /// A bound counts as above the target (or the donors' limit) only past this factor
+    /// of it: rounding in the rows does not raise a particle or flag it.
+    static constexpr double bound_tolerance = 1 + 1e-9;
+
     /// Writes or reads the state for a checkpoint (see lacerta::Archive).
     void
     serialize(Archive &archive);
