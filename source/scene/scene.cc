@@ -296,7 +296,7 @@ namespace lacerta::scene
                     " kg; the density must be positive and finite on the object.");
 
     system->cell_stiffness.clear();
-    if (&active != &mesh && multiresolution->condenses_stiffness())
+    if (&active != &mesh && multiresolution->has_coarse_stiffness())
     {
       system->cell_stiffness = multiresolution->active_cell_stiffnesses();
       system->springs        = physics::compute_springs(active, system->cell_stiffness);

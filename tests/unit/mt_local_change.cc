@@ -93,7 +93,7 @@ namespace lacerta
        1e-10},
       {"square_lod.prm",
        "subsection Mesh\n  subsection Box\n    set Repetitions = 12, 12, 3\n  end\nend\n"
-       "subsection Multiresolution\n  set Coarse stiffness = condensed\nend\n",
+       "subsection Multiresolution\n  set Coarse stiffness = rule\nend\n",
        {{"-0.05 + 0.1*t", "0.01*t", "0.02"}},
        1e-10},
       {"kidney_lod.prm",

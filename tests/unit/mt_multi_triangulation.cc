@@ -2,6 +2,7 @@
 
 #include <lacerta/mt/builder.h>
 #include <lacerta/mt/coarse_stiffness.h>
+#include <lacerta/mt/homogenized_stiffness.h>
 #include <lacerta/mt/lod.h>
 #include <lacerta/mt/lod_query.h>
 #include <lacerta/mt/storage.h>
@@ -565,5 +566,53 @@ namespace lacerta
     // The root carries stiffness: nothing was condensed to nothing.
     EXPECT_GT(total_root, 0.0);
     EXPECT_GT(total_input, 0.0);
+  }
+} // namespace lacerta
+
+
+namespace lacerta
+{
+  TEST(MultiTriangulation, HomogenizedScaleMatchesTheInputMeshsEnergyUnderUniformStrain)
+  {
+    // Under a uniform strain every tetrahedron's Section 3.2 springs hold 3 E per
+    // volume summed over the six unit strains (Σ over an orthonormal basis of
+    // (n·ε n)² is |n ⊗ n|² = 1 per edge): the energy of the affine field. Relaxing the
+    // interior can only lower it.
+    const double E    = 1e4;
+    const auto   rule = [&](const std::array<mesh::Point3, 4> &x)
+    { return physics::paper_edge_stiffnesses(x, E); };
+    // The regular box's lattice relaxes nothing, and its root (no interior vertex)
+    // cannot: the scale is 1.
+    const mt::HomogenizedScale box = mt::homogenized_coarse_scale(box_mt(), rule);
+    EXPECT_NEAR(box.fine_energy_density, 3 * E, 1e-8 * E);
+    EXPECT_NEAR(box.coarse_energy_density, 3 * E, 1e-8 * E);
+    EXPECT_NEAR(box.scale, 1.0, 1e-8);
+    // A distorted box relaxes; its root of a few cells does not, so the coarse cells
+    // are the stiffer material and are scaled down.
+    const mt::MultiTriangulation distorted = mt::build_multi_triangulation(
+      test_support::distorted_box(8, 0.4, dealii::Point<3>(1, 1, 1)),
+      mt::BuilderParameters());
+    const mt::HomogenizedScale down = mt::homogenized_coarse_scale(distorted, rule);
+    EXPECT_LT(down.fine_energy_density, 0.9 * 3 * E);
+    EXPECT_LT(down.scale, 0.9);
+    // The rounded box's root keeps interior vertices and relaxes more than the input
+    // mesh: scaled up. All its cells are decimated ones, so the energy is linear in
+    // the scale and the scale is the ratio of the densities.
+    const mt::MultiTriangulation rounded =
+      mt::build_multi_triangulation(rounded_box(), mt::BuilderParameters());
+    for (std::uint32_t t = rounded.fine_begin[0]; t < rounded.fine_begin[1]; ++t)
+      ASSERT_NE(rounded.destroyer[t], mesh::invalid_index);
+    const mt::HomogenizedScale h = mt::homogenized_coarse_scale(rounded, rule);
+    EXPECT_LT(h.fine_energy_density, 3 * E);
+    EXPECT_LT(h.coarse_energy_density, h.fine_energy_density);
+    EXPECT_GT(h.scale, 1.02);
+    EXPECT_NEAR(h.scale, h.fine_energy_density / h.coarse_energy_density, 1e-5);
+    // It does not depend on the modulus.
+    const mt::HomogenizedScale stiffer =
+      mt::homogenized_coarse_scale(rounded,
+                                   [&](const std::array<mesh::Point3, 4> &x)
+                                   { return physics::paper_edge_stiffnesses(x, 7 * E); });
+    EXPECT_NEAR(stiffer.scale, h.scale, 1e-5 * h.scale);
+    EXPECT_NEAR(stiffer.fine_energy_density, 7 * h.fine_energy_density, 1e-6 * E);
   }
 } // namespace lacerta

@@ -9,6 +9,7 @@
 #include <lacerta/cut/geometry.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/mt/coarse_stiffness.h>
+#include <lacerta/mt/homogenized_stiffness.h>
 #include <lacerta/mt/lod.h>
 #include <lacerta/mt/lod_query.h>
 #include <lacerta/mt/mt_cutter.h>
@@ -144,24 +145,28 @@ namespace lacerta::mt
 
     /**
      * Sets the spring rule of the scene's material (Section 3.2's, or fitted springs)
-     * and, with `Coarse stiffness = condensed`, condenses every coarse fragment's
-     * stiffness from the fine mesh (condensed_edge_stiffnesses()).
+     * and the coarse cells' stiffness from it (`Coarse stiffness`): with `homogenized`,
+     * the one factor on the decimated cells that gives the coarsest mesh the input
+     * mesh's energy under uniform strain (homogenized_coarse_scale()); with
+     * `condensed`, every coarse fragment's stiffness condensed from the fine mesh
+     * (condensed_edge_stiffnesses()).
      */
     void
     set_stiffness_rule(const EdgeStiffnessRule &rule);
 
-    /// Whether the coarse cells take condensed stiffnesses (`Coarse stiffness =
-    /// condensed`) rather than the rule.
+    /// Whether the coarse cells' springs differ from the rule (`Coarse stiffness` is
+    /// not `rule`): the cells then carry their own stiffnesses (edge_stiffnesses()).
     bool
-    condenses_stiffness() const
+    has_coarse_stiffness() const
     {
-      return condenses;
+      return coarse_stiffness != CoarseStiffness::rule;
     }
 
     /**
      * The contributions to its six edges' stiffnesses (local edge order) of the
-     * active mesh's cell @p cell (particle ids) that is MT tetrahedron @p t: condensed,
-     * or the rule for tetrahedra a cut made.
+     * active mesh's cell @p cell (particle ids) that is MT tetrahedron @p t: the rule,
+     * times the homogenized factor for a decimated tetrahedron, or condensed; the rule
+     * for tetrahedra a cut made.
      */
     std::array<double, 6>
     edge_stiffnesses(std::uint32_t t, const mesh::Tet &cell) const;
@@ -228,8 +233,17 @@ namespace lacerta::mt
     std::unique_ptr<Lod>                       lod;
     std::unique_ptr<LodQuery>                  query;
     std::unique_ptr<dealii::FunctionParser<3>> path;
-    /// `Coarse stiffness = condensed`.
-    bool condenses = false;
+    /// `Coarse stiffness`.
+    enum class CoarseStiffness
+    {
+      rule,
+      homogenized,
+      condensed
+    } coarse_stiffness = CoarseStiffness::rule;
+    /// With `homogenized`: the factor, what it matched, and the tetrahedra of the MT
+    /// as built (those a cut appends after it take the rule).
+    HomogenizedScale homogenized;
+    std::uint32_t    built_tets = 0;
     /// The material's spring rule (set_stiffness_rule()).
     EdgeStiffnessRule rule;
     /// Per MT tetrahedron, its edges' condensed stiffness contributions (empty with
