@@ -1,6 +1,7 @@
 // lacerta-bench mt: Multi-Triangulation build time and memory, extraction time from
 // scratch and incremental. lacerta-bench lod: LOD simulation error against run time.
 
+#include <lacerta/base/exceptions.h>
 #include <lacerta/fem/spring_statics.h>
 #include <lacerta/mesh/triangulation_conversion.h>
 #include <lacerta/mt/builder.h>
@@ -19,7 +20,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <sys/resource.h>
@@ -253,14 +256,79 @@ namespace lacerta::bench
     }
 
 
+    /// One level of detail of run_lod(): its growth, size, speed-up and errors.
+    struct LodPoint
+    {
+      std::string growth;
+      std::size_t tets;
+      double      speed_up, rms_error, largest_error, frequency_ratio;
+    };
+
+
     /**
-     * The LOD speed-up against accuracy: a scene (default prm/square_lod.prm) run to
-     * its end time (default 0.5 s) at full resolution and on levels of detail of
-     * several growths; for each, the wall time and the displacement error at the
-     * particles the LOD keeps, against the full resolution (largest and RMS, relative
-     * to the largest displacement), as `lod.<variant>.<figure>`; and the lowest four
-     * eigenfrequencies of the full mesh and of each first level of detail, with their
-     * ratio to the full mesh's (`frequency_ratio_<i>`).
+     * Issue 17's targets on @p points: the largest speed-up at an RMS error of at most
+     * @p error, printed as `lod.best_speed_up_within_<percent>_percent` (0 if none).
+     */
+    void
+    print_target(const std::vector<LodPoint> &points, const double error)
+    {
+      double best = 0;
+      for (const LodPoint &p : points)
+        if (p.rms_error <= error)
+          best = std::max(best, p.speed_up);
+      print_figure("lod.best_speed_up_within_" + std::to_string(int(100 * error + 0.5))
+                     + "_percent",
+                   best,
+                   "");
+    }
+
+
+    /// Writes @p points (a run to @p end_time) as `<stem>-lod-t<end time>.csv` in the
+    /// current directory and plots them (contrib/plot/plot_lod.py) as the same name's
+    /// `.png` if python3 and matplotlib are there; prints the files written.
+    void
+    write_lod_curve(const std::string           &file,
+                    const double                 end_time,
+                    const std::vector<LodPoint> &points)
+    {
+      const std::string  stem = std::filesystem::path(file).stem().string();
+      std::ostringstream name;
+      name << stem << "-lod-t" << end_time;
+      const std::string csv = name.str() + ".csv";
+      {
+        std::ofstream out(csv);
+        out << "scene,end_time,growth,tetrahedra,speed_up,rms_error,largest_error,"
+               "frequency_ratio\n";
+        for (const LodPoint &p : points)
+          out << stem << ',' << end_time << ',' << p.growth << ',' << p.tets << ','
+              << p.speed_up << ',' << p.rms_error << ',' << p.largest_error << ','
+              << p.frequency_ratio << '\n';
+        if (!out)
+          throw_error("lacerta-bench lod: cannot write ", csv, ".");
+      }
+      std::cout << "Wrote " << csv << "\n";
+      const std::string png     = name.str() + ".png";
+      const std::string command = std::string(LACERTA_PYTHON)
+                                  + " " LACERTA_SOURCE_DIR "/contrib/plot/plot_lod.py "
+                                  + csv + " -o " + png + " > /dev/null 2>&1";
+      if (std::system(command.c_str()) == 0)
+        std::cout << "Wrote " << png << "\n";
+      else
+        std::cout << "No plot: " << LACERTA_PYTHON
+                  << " with matplotlib did not run contrib/plot/plot_lod.py\n";
+    }
+
+
+    /**
+     * The LOD speed-up against accuracy: a scene (default prm/square_lod.prm to 0.5 s)
+     * run to an end time (default: the scene's own) at full resolution and on levels
+     * of detail of several growths; for each, the wall time and the displacement error
+     * at the particles the LOD keeps, against the full resolution (largest and RMS,
+     * relative to the largest displacement), as `lod.<variant>.<figure>`; the lowest
+     * four eigenfrequencies of the full mesh and of each first level of detail, with
+     * their ratio to the full mesh's (`frequency_ratio_<i>`); the largest speed-ups
+     * within 5 % and 2 % RMS error (issue 17's targets); and the curve as a CSV file
+     * and a plot (write_lod_curve()).
      */
     int
     run_lod(const std::vector<std::string> &arguments)
@@ -268,8 +336,17 @@ namespace lacerta::bench
       const std::string file =
         arguments.size() > 0 ? arguments[0]
                              : std::string(LACERTA_SOURCE_DIR) + "/prm/square_lod.prm";
-      const double end_time = arguments.size() > 1 ? std::stod(arguments[1]) : 0.5;
-      const Run    full =
+      double end_time = 0.5;
+      if (arguments.size() > 1)
+        end_time = std::stod(arguments[1]);
+      else if (arguments.size() == 1)
+      {
+        dealii::ParameterHandler prm;
+        Simulator::read_parameters(file, prm);
+        end_time = prm.get_double("End time");
+      }
+      std::vector<LodPoint> points;
+      const Run             full =
         simulate(file,
                  end_time,
                  "subsection Multiresolution\n set Enabled = false\nend\n");
@@ -346,7 +423,16 @@ namespace lacerta::bench
         print_figure(prefix + "reextraction_cost_in_steps",
                      lod.reextraction_seconds / lod.step_seconds,
                      "");
+        points.push_back({growth,
+                          lod.tets,
+                          full.seconds / lod.seconds,
+                          std::sqrt(squares / lod.vertices.size()) / largest,
+                          worst / largest,
+                          level.frequencies[0] / full_modes[0]});
       }
+      print_target(points, 0.05);
+      print_target(points, 0.02);
+      write_lod_curve(file, end_time, points);
       return 0;
     }
 
@@ -464,8 +550,10 @@ namespace lacerta::bench
                              "incremental (arguments: box sizes n, n^3 x 5 tetrahedra; "
                              "default 13 27 59)",
                              run_mt);
-  LACERTA_REGISTER_BENCHMARK("lod",
-                             "LOD simulation error against run time (arguments: scene, "
-                             "end time; default prm/square_lod.prm 0.5)",
-                             run_lod);
+  LACERTA_REGISTER_BENCHMARK(
+    "lod",
+    "LOD simulation error against run time (arguments: scene, "
+    "end time; default prm/square_lod.prm 0.5, a scene's own end "
+    "time); writes <scene>-lod-t<end time>.csv and .png",
+    run_lod);
 } // namespace lacerta::bench
