@@ -1,5 +1,6 @@
 #include <lacerta/base/checkpoint_file.h>
 #include <lacerta/base/exceptions.h>
+#include <lacerta/base/fnv_hash.h>
 #include <lacerta/base/output_file.h>
 
 #include <cerrno>
@@ -20,17 +21,13 @@ namespace lacerta
     constexpr std::size_t      header_bytes =
       magic.size() + sizeof(std::uint32_t) + 2 * sizeof(std::uint64_t);
 
-    /// FNV-1a, 64 bits: enough to tell a damaged file from a whole one.
+    /// FNV-1a of @p bytes: enough to tell a damaged file from a whole one.
     std::uint64_t
     checksum(const std::string_view bytes)
     {
-      std::uint64_t hash = 0xcbf29ce484222325ULL;
-      for (const char c : bytes)
-      {
-        hash ^= static_cast<unsigned char>(c);
-        hash *= 0x100000001b3ULL;
-      }
-      return hash;
+      FnvHash hash;
+      hash.add(bytes.data(), bytes.size());
+      return hash.value;
     }
 
     template <class T>

@@ -1,4 +1,5 @@
 #include <lacerta/base/exceptions.h>
+#include <lacerta/base/fnv_hash.h>
 #include <lacerta/mesh/point.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/mt/homogenized_stiffness.h>
@@ -13,6 +14,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
 
 namespace lacerta::mt
 {
@@ -239,6 +243,41 @@ namespace lacerta::mt
       }
       return energy / net.volume;
     }
+
+
+    /// The tetrahedra of the input mesh and of the coarsest mesh of the MT as built
+    /// (those a cut appended later are in neither).
+    std::array<std::vector<std::uint32_t>, 2>
+    input_and_root(const MultiTriangulation &mt)
+    {
+      std::array<std::vector<std::uint32_t>, 2> meshes;
+      for (std::uint32_t t = 0; t < mt.fine_begin.back(); ++t)
+      {
+        if (mt.destroyer[t] == mesh::invalid_index)
+          meshes[0].push_back(t);
+        if (mt.creator[t] == 0)
+          meshes[1].push_back(t);
+      }
+      return meshes;
+    }
+
+
+    /// FNV-1a over @p rule's stiffnesses on the tetrahedra of both meshes.
+    std::uint64_t
+    rule_checksum(const MultiTriangulation &mt, const EdgeStiffnessRule &rule)
+    {
+      FnvHash hash;
+      for (const auto &tets : input_and_root(mt))
+        for (const std::uint32_t t : tets)
+        {
+          std::array<mesh::Point3, 4> corner;
+          for (unsigned int i = 0; i < 4; ++i)
+            corner[i] = mt.vertices[mt.tets[t][i]];
+          const std::array<double, 6> k = rule(corner);
+          hash.add(k.data(), sizeof(k));
+        }
+      return hash.value;
+    }
   } // namespace
 
 
@@ -248,16 +287,7 @@ namespace lacerta::mt
     HomogenizedScale result;
     if (mt.n_nodes() < 2)
       return result;
-    // The MT as built: tetrahedra a cut appended later are in neither mesh.
-    const std::uint32_t        built = mt.fine_begin.back();
-    std::vector<std::uint32_t> fine, root;
-    for (std::uint32_t t = 0; t < built; ++t)
-    {
-      if (mt.destroyer[t] == mesh::invalid_index)
-        fine.push_back(t);
-      if (mt.creator[t] == 0)
-        root.push_back(t);
-    }
+    const auto [fine, root]      = input_and_root(mt);
     result.fine_energy_density   = relaxed_energy_density(network_of(mt, fine, rule), 1);
     const Network coarse         = network_of(mt, root, rule);
     result.coarse_energy_density = relaxed_energy_density(coarse, 1);
@@ -289,5 +319,43 @@ namespace lacerta::mt
                   " J/m^3); use 'Coarse stiffness = rule'.");
     result.scale = s0;
     return result;
+  }
+
+
+  HomogenizedScale
+  cached_homogenized_coarse_scale(const MultiTriangulation &mt,
+                                  const EdgeStiffnessRule  &rule,
+                                  const std::string        &file)
+  {
+    if (file.empty())
+      return homogenized_coarse_scale(mt, rule);
+    const std::uint64_t key    = rule_checksum(mt, rule);
+    const std::string   format = "lacerta-homogenized-scale-1";
+    {
+      std::ifstream    in(file);
+      std::string      name;
+      std::uint64_t    stored = 0;
+      HomogenizedScale h;
+      if (in >> name >> stored >> h.scale >> h.fine_energy_density
+            >> h.coarse_energy_density >> h.iterations
+          && name == format && stored == key && std::isfinite(h.scale) && h.scale > 0)
+      {
+        h.loaded = true;
+        return h;
+      }
+    }
+    const HomogenizedScale h         = homogenized_coarse_scale(mt, rule);
+    const std::string      temporary = file + ".tmp";
+    {
+      std::ofstream out(temporary);
+      out << format << ' ' << key << ' ' << std::setprecision(17) << h.scale << ' '
+          << h.fine_energy_density << ' ' << h.coarse_energy_density << ' '
+          << h.iterations << '\n';
+      if (!out)
+        return h;
+    }
+    std::error_code error;
+    std::filesystem::rename(temporary, file, error);
+    return h;
   }
 } // namespace lacerta::mt

@@ -31,8 +31,10 @@ namespace lacerta::mt
                       "mt-cache",
                       dealii::Patterns::Anything(),
                       "Where built MTs are kept, one file per mesh and builder "
-                      "parameters (mt-<key>.lmt); a stale or corrupted file is rebuilt. "
-                      "Empty: always build, never write.");
+                      "parameters (mt-<key>.lmt), with the homogenized coarse "
+                      "stiffness of the material beside it (mt-<key>.lmt.homogenized); "
+                      "a stale or corrupted file is rebuilt. Empty: always build, never "
+                      "write.");
     prm.declare_entry("Focus path",
                       "0; 0; 0",
                       dealii::Patterns::Anything(),
@@ -285,7 +287,8 @@ namespace lacerta::mt
     rule       = rule_in;
     built_tets = mt.fine_begin.back();
     if (coarse_stiffness == CoarseStiffness::homogenized)
-      homogenized = homogenized_coarse_scale(mt, rule);
+      homogenized = cached_homogenized_coarse_scale(
+        mt, rule, cache.file.empty() ? std::string() : cache.file + ".homogenized");
     if (coarse_stiffness == CoarseStiffness::condensed)
       condensed = condensed_edge_stiffnesses(mt, rule);
   }
@@ -514,7 +517,8 @@ namespace lacerta::mt
       out << "\nCoarse stiffness: the decimated cells' springs times "
           << homogenized.scale << " (energy density under unit strains: input mesh "
           << homogenized.fine_energy_density << " J/m^3, coarsest mesh "
-          << homogenized.coarse_energy_density << " J/m^3 unscaled)";
+          << homogenized.coarse_energy_density << " J/m^3 unscaled"
+          << (homogenized.loaded ? "; from the cache)" : ")");
     out << "\nLevel of detail: " << mesh.n_tets() << " tetrahedra, " << mesh.n_vertices()
         << " particles, focus at (" << last_focus[0] << ", " << last_focus[1] << ", "
         << last_focus[2] << ")\n";

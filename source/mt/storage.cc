@@ -1,4 +1,5 @@
 #include <lacerta/base/exceptions.h>
+#include <lacerta/base/fnv_hash.h>
 #include <lacerta/base/output_file.h>
 #include <lacerta/mt/storage.h>
 
@@ -14,28 +15,6 @@ namespace lacerta::mt
   namespace
   {
     constexpr char magic[8] = {'L', 'A', 'C', 'E', 'R', 'T', 'M', 'T'};
-
-    /// FNV-1a, 64 bit, over raw bytes.
-    class Hash
-    {
-    public:
-      void
-      add(const void *data, const std::size_t bytes)
-      {
-        const auto *p = static_cast<const unsigned char *>(data);
-        for (std::size_t i = 0; i < bytes; ++i)
-          value = (value ^ p[i]) * 1099511628211ull;
-      }
-
-      template <typename T>
-      void
-      add_vector(const std::vector<T> &v)
-      {
-        add(v.data(), v.size() * sizeof(T));
-      }
-
-      std::uint64_t value = 14695981039346656037ull;
-    };
 
     /// Applies @p f to every array of @p mt, in file order.
     template <typename MT, typename F>
@@ -64,7 +43,7 @@ namespace lacerta::mt
             const BuilderParameters         &parameters,
             const std::vector<unsigned int> &locked)
   {
-    Hash hash;
+    FnvHash hash;
     hash.add(&file_format_version, sizeof(file_format_version));
     hash.add_vector(mesh.get_vertices());
     hash.add_vector(mesh.get_tets());
@@ -92,7 +71,7 @@ namespace lacerta::mt
                      put(&n, sizeof(n));
                    });
     for_each_array(mt, [&](const auto &v) { put(v.data(), v.size() * sizeof(v[0])); });
-    Hash hash;
+    FnvHash hash;
     hash.add(buffer.data(), buffer.size());
     put(&hash.value, sizeof(hash.value));
 
@@ -147,7 +126,7 @@ namespace lacerta::mt
       reason = "corrupted (truncated)";
       return std::nullopt;
     }
-    Hash hash;
+    FnvHash hash;
     hash.add(buffer.data(), buffer.size() - sizeof(std::uint64_t));
     std::uint64_t checksum = 0;
     std::memcpy(&checksum,

@@ -19,6 +19,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <unistd.h>
 
 namespace lacerta
 {
@@ -614,5 +615,31 @@ namespace lacerta
                                    { return physics::paper_edge_stiffnesses(x, 7 * E); });
     EXPECT_NEAR(stiffer.scale, h.scale, 1e-5 * h.scale);
     EXPECT_NEAR(stiffer.fine_energy_density, 7 * h.fine_energy_density, 1e-6 * E);
+
+    // Kept in a file: read back for the same rule only, recomputed when the file is
+    // damaged.
+    const std::string file = (std::filesystem::temp_directory_path()
+                              / ("lacerta_homogenized_" + std::to_string(::getpid())))
+                               .string();
+    std::filesystem::remove(file);
+    const mt::HomogenizedScale first =
+      mt::cached_homogenized_coarse_scale(rounded, rule, file);
+    EXPECT_FALSE(first.loaded);
+    EXPECT_EQ(first.scale, h.scale);
+    const mt::HomogenizedScale again =
+      mt::cached_homogenized_coarse_scale(rounded, rule, file);
+    EXPECT_TRUE(again.loaded);
+    EXPECT_EQ(again.scale, h.scale);
+    EXPECT_EQ(again.fine_energy_density, h.fine_energy_density);
+    const mt::HomogenizedScale other = mt::cached_homogenized_coarse_scale(
+      rounded,
+      [&](const std::array<mesh::Point3, 4> &x)
+      { return physics::paper_edge_stiffnesses(x, 7 * E); },
+      file);
+    EXPECT_FALSE(other.loaded);
+    std::ofstream(file) << "lacerta-homogenized-scale-1 12 nan";
+    EXPECT_FALSE(mt::cached_homogenized_coarse_scale(rounded, rule, file).loaded);
+    EXPECT_TRUE(mt::cached_homogenized_coarse_scale(rounded, rule, file).loaded);
+    std::filesystem::remove(file);
   }
 } // namespace lacerta

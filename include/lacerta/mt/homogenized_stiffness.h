@@ -9,6 +9,8 @@
 #include <lacerta/mt/coarse_stiffness.h>
 #include <lacerta/mt/multi_triangulation.h>
 
+#include <string>
+
 namespace lacerta::mt
 {
   /**
@@ -25,6 +27,8 @@ namespace lacerta::mt
     double coarse_energy_density = 0;
     /// Linear solves on the coarsest mesh until its energy matched.
     unsigned int iterations = 0;
+    /// Whether it was read from a cache file (cached_homogenized_coarse_scale()).
+    bool loaded = false;
   };
 
   /**
@@ -46,4 +50,17 @@ namespace lacerta::mt
    */
   HomogenizedScale
   homogenized_coarse_scale(const MultiTriangulation &mt, const EdgeStiffnessRule &rule);
+
+  /**
+   * homogenized_coarse_scale(), kept in the file @p file: read from it when it holds
+   * the result for the same rule (a checksum of @p rule's stiffnesses on the input and
+   * coarsest meshes' tetrahedra, which the MT's own cache key does not cover),
+   * otherwise computed and written there (a temporary file renamed into place). An
+   * empty @p file only computes; a file that cannot be read or written is recomputed
+   * or left, not an error.
+   */
+  HomogenizedScale
+  cached_homogenized_coarse_scale(const MultiTriangulation &mt,
+                                  const EdgeStiffnessRule  &rule,
+                                  const std::string        &file);
 } // namespace lacerta::mt
