@@ -139,8 +139,11 @@ namespace lacerta::physics
 
     segments.assign(2 * ranges.n_parts(), Segment());
     holders.assign(system.springs.size(), no_holders());
+    pending_erase.assign(segments.size(), {});
+    pending_insert.assign(segments.size(), {});
     for (unsigned int s = 0; s < system.springs.size(); ++s)
       place(system, s);
+    apply_pending();
     known_springs = system.springs.size();
   }
 
@@ -176,6 +179,7 @@ namespace lacerta::physics
         ranges.update_inverse_mass(system, system.springs.a[s]);
         ranges.update_inverse_mass(system, system.springs.b[s]);
       }
+    apply_pending();
     holders.resize(n_springs);
     known_springs = n_springs;
 
@@ -278,9 +282,11 @@ namespace lacerta::physics
     std::array<std::array<unsigned int, 3>, 2> wanted = {{{2 * pa, a, b}, {none, 0, 0}}};
     if (pa != pb)
       wanted = {{{2 * pa + 1, a, b}, {2 * pb + 1, b, a}}};
+    pending_erase.resize(segments.size());
+    pending_insert.resize(segments.size());
     for (const unsigned int g : holders[s])
       if (g != none && g != wanted[0][0] && g != wanted[1][0])
-        erase(g, s);
+        pending_erase[g].push_back(s);
     const Holders old = holders[s];
     holders[s]        = no_holders();
     for (unsigned int c = 0; c < 2; ++c)
@@ -288,23 +294,90 @@ namespace lacerta::physics
       const auto [g, from, to] = wanted[c];
       if (g == none)
         continue;
-      holders[s][c]             = g;
-      Segment          &segment = segments[g];
-      const std::size_t slot_k  = slot(g, s);
+      holders[s][c] = g;
       if (g == old[0] || g == old[1])
       {
+        Segment          &segment       = segments[g];
+        const std::size_t slot_k        = slot(g, s);
         segment.set.a[slot_k]           = from;
         segment.set.b[slot_k]           = to;
         segment.set.stiffness[slot_k]   = k;
         segment.set.rest_length[slot_k] = all.rest_length[s];
         continue;
       }
-      segment.set.a.insert(segment.set.a.begin() + slot_k, from);
-      segment.set.b.insert(segment.set.b.begin() + slot_k, to);
-      segment.set.stiffness.insert(segment.set.stiffness.begin() + slot_k, k);
-      segment.set.rest_length.insert(segment.set.rest_length.begin() + slot_k,
-                                     all.rest_length[s]);
-      segment.origin.insert(segment.origin.begin() + slot_k, s);
+      pending_insert[g].push_back({s, from, to, k, all.rest_length[s]});
+    }
+  }
+
+
+  void
+  LinearSprings::apply_pending()
+  {
+    for (std::size_t g = 0; g < pending_erase.size(); ++g)
+    {
+      Segment &segment = segments[g];
+      auto    &gone    = pending_erase[g];
+      if (!gone.empty())
+      {
+        std::sort(gone.begin(), gone.end());
+        std::size_t out = 0, next = 0;
+        for (std::size_t i = 0; i < segment.origin.size(); ++i)
+        {
+          while (next < gone.size() && gone[next] < segment.origin[i])
+            ++next;
+          if (next < gone.size() && gone[next] == segment.origin[i])
+            continue;
+          segment.origin[out]          = segment.origin[i];
+          segment.set.a[out]           = segment.set.a[i];
+          segment.set.b[out]           = segment.set.b[i];
+          segment.set.stiffness[out]   = segment.set.stiffness[i];
+          segment.set.rest_length[out] = segment.set.rest_length[i];
+          ++out;
+        }
+        segment.origin.resize(out);
+        segment.set.a.resize(out);
+        segment.set.b.resize(out);
+        segment.set.stiffness.resize(out);
+        segment.set.rest_length.resize(out);
+        gone.clear();
+      }
+      auto &come = pending_insert[g];
+      if (come.empty())
+        continue;
+      std::sort(come.begin(),
+                come.end(),
+                [](const PendingCopy &x, const PendingCopy &y) { return x.s < y.s; });
+      // Merged from the back, in place: the segment grows by the copies that come.
+      const std::size_t n = segment.origin.size(), m = come.size();
+      segment.origin.resize(n + m);
+      segment.set.a.resize(n + m);
+      segment.set.b.resize(n + m);
+      segment.set.stiffness.resize(n + m);
+      segment.set.rest_length.resize(n + m);
+      std::size_t i = n, j = m, out = n + m;
+      while (j > 0)
+      {
+        --out;
+        if (i > 0 && segment.origin[i - 1] > come[j - 1].s)
+        {
+          --i;
+          segment.origin[out]          = segment.origin[i];
+          segment.set.a[out]           = segment.set.a[i];
+          segment.set.b[out]           = segment.set.b[i];
+          segment.set.stiffness[out]   = segment.set.stiffness[i];
+          segment.set.rest_length[out] = segment.set.rest_length[i];
+        }
+        else
+        {
+          --j;
+          segment.origin[out]          = come[j].s;
+          segment.set.a[out]           = come[j].from;
+          segment.set.b[out]           = come[j].to;
+          segment.set.stiffness[out]   = come[j].stiffness;
+          segment.set.rest_length[out] = come[j].rest_length;
+        }
+      }
+      come.clear();
     }
   }
 

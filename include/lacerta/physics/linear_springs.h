@@ -119,11 +119,28 @@ namespace lacerta::physics
 
     /**
      * Puts system spring @p s (as it is now) into the segments of its ranges: in
-     * place where it already has a copy in that segment, in order otherwise; copies
-     * in segments it left are removed.
+     * place where it already has a copy in that segment; copies it needs in other
+     * segments, and the removal of its copies in segments it left, wait for
+     * apply_pending().
      */
     void
     place(const ParticleSystem &system, unsigned int s);
+
+    /// Takes out and puts in the copies place() left pending, one pass per segment
+    /// that has any (in the springs' order), so that a change of many springs costs
+    /// one merge per segment instead of one shift of the segment per spring.
+    void
+    apply_pending();
+
+    /// A copy waiting to be put into a segment.
+    struct PendingCopy
+    {
+      unsigned int s, from, to;
+      double       stiffness, rest_length;
+    };
+    /// Per segment: the springs whose copies leave it, and the copies that come.
+    std::vector<std::vector<unsigned int>> pending_erase;
+    std::vector<std::vector<PendingCopy>>  pending_insert;
 
     /// Whether a range evaluates more than 1.25 times the mean number of spring
     /// copies (plus a little, so that small systems are not re-partitioned).
