@@ -27,8 +27,9 @@ namespace lacerta::physics
    * Each range's inner and crossing springs are a segment of their own, kept in the
    * order of the system's springs, and every system spring knows which segments hold
    * its copies, so that a cut updates only the springs it changed (springs_changed()):
-   * a copy whose segment stays is rewritten in place (found by bisection), one that
-   * changes range is moved, removed springs are the last ones. The evaluation then
+   * a copy whose segment stays is rewritten in place (found by bisection), the copies
+   * that change range are moved, merged into each segment they leave or join in one
+   * pass per change, removed springs are the last ones. The evaluation then
    * sums every particle's forces in the order a model made afresh on the same ranges
    * would: on one range the forces are those of initialize() to the last bit. New
    * particles join the last range; when the ranges' loads drift apart by more than a
