@@ -11,17 +11,6 @@ namespace lacerta::mt
 {
   namespace
   {
-    /// The rest vertices of MT tetrahedron @p t.
-    std::array<mesh::Point3, 4>
-    corners(const MultiTriangulation &mt, const std::uint32_t t)
-    {
-      std::array<mesh::Point3, 4> x;
-      for (unsigned int i = 0; i < 4; ++i)
-        x[i] = mt.vertices[mt.tets[t][i]];
-      return x;
-    }
-
-
     /**
      * The vertices of the fragments of one node and their linearised spring
      * stiffness (3n x 3n, node-major, row-major), with the removed vertex last.
@@ -245,7 +234,7 @@ namespace lacerta::mt
     std::vector<std::array<double, 6>> k(mt.n_tets());
     for (std::uint32_t t = 0; t < mt.n_tets(); ++t)
       if (mt.destroyer[t] == mesh::invalid_index)
-        k[t] = rule(corners(mt, t));
+        k[t] = rule(mt.corners(t));
     Fragment                                 fragment;
     std::vector<mesh::Point3>                points;
     std::vector<std::array<unsigned int, 2>> edges;
@@ -303,7 +292,7 @@ namespace lacerta::mt
       std::vector<std::array<double, 6>>       weight(coarse.size());
       for (std::size_t c = 0; c < coarse.size(); ++c)
       {
-        weight[c] = rule(corners(mt, coarse[c]));
+        weight[c] = rule(mt.corners(coarse[c]));
         for (unsigned int e = 0; e < 6; ++e)
         {
           const auto [i0, i1] = mesh::TetMesh::edge_vertices[e];

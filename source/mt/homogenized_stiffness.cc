@@ -63,17 +63,12 @@ namespace lacerta::mt
       std::vector<std::array<unsigned int, 3>> faces;
       for (const std::uint32_t t : tets)
       {
-        std::array<mesh::Point3, 4> corner;
-        std::array<unsigned int, 4> v;
+        const std::array<mesh::Point3, 4> corner = mt.corners(t);
+        std::array<unsigned int, 4>       v;
         for (unsigned int i = 0; i < 4; ++i)
-        {
-          corner[i] = mt.vertices[mt.tets[t][i]];
-          v[i]      = local_of(mt.tets[t][i]);
-        }
-        net.volume += std::abs(mesh::dot(mesh::cross(mesh::sub(corner[1], corner[0]),
-                                                     mesh::sub(corner[2], corner[0])),
-                                         mesh::sub(corner[3], corner[0])))
-                      / 6;
+          v[i] = local_of(mt.tets[t][i]);
+        net.volume +=
+          std::abs(mesh::signed_volume(corner[0], corner[1], corner[2], corner[3]));
         const bool                  coarse = mt.destroyer[t] != mesh::invalid_index;
         const std::array<double, 6> k      = rule(corner);
         for (unsigned int e = 0; e < 6; ++e)
@@ -270,10 +265,7 @@ namespace lacerta::mt
       for (const auto &tets : input_and_root(mt))
         for (const std::uint32_t t : tets)
         {
-          std::array<mesh::Point3, 4> corner;
-          for (unsigned int i = 0; i < 4; ++i)
-            corner[i] = mt.vertices[mt.tets[t][i]];
-          const std::array<double, 6> k = rule(corner);
+          const std::array<double, 6> k = rule(mt.corners(t));
           hash.add(k.data(), sizeof(k));
         }
       return hash.value;

@@ -19,6 +19,14 @@ namespace lacerta::mt
   }
 
 
+  std::array<mesh::Point3, 4>
+  MultiTriangulation::corners(const unsigned int t) const
+  {
+    const auto &[a, b, c, d] = tets[t];
+    return {{vertices[a], vertices[b], vertices[c], vertices[d]}};
+  }
+
+
   std::array<double, 4>
   MultiTriangulation::barycentric(const unsigned int t, const mesh::Point3 &p) const
   {

@@ -170,6 +170,9 @@ namespace lacerta::physics
     std::sort(listed.begin(), listed.end());
     listed.erase(std::unique(listed.begin(), listed.end()), listed.end());
     holders.resize(std::max(known_springs, n_springs), no_holders());
+    // place() queues copies per segment; a restored model has none queued yet.
+    pending_erase.resize(segments.size());
+    pending_insert.resize(segments.size());
     for (auto s = listed.rbegin(); s != listed.rend() && *s >= n_springs; ++s)
       unplace(*s);
     for (const unsigned int s : listed)
@@ -282,8 +285,6 @@ namespace lacerta::physics
     std::array<std::array<unsigned int, 3>, 2> wanted = {{{2 * pa, a, b}, {none, 0, 0}}};
     if (pa != pb)
       wanted = {{{2 * pa + 1, a, b}, {2 * pb + 1, b, a}}};
-    pending_erase.resize(segments.size());
-    pending_insert.resize(segments.size());
     for (const unsigned int g : holders[s])
       if (g != none && g != wanted[0][0] && g != wanted[1][0])
         pending_erase[g].push_back(s);

@@ -196,6 +196,10 @@ namespace lacerta::mt
     std::size_t
     memory_bytes() const;
 
+    /// The rest positions of the four vertices of tet @p t, in its vertex order.
+    std::array<mesh::Point3, 4>
+    corners(unsigned int t) const;
+
     /**
      * Barycentric coordinates of point @p p in tet @p t (rest configuration); all are
      * >= 0 when p lies in the tet.
