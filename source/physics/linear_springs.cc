@@ -227,18 +227,36 @@ namespace lacerta::physics
 
 
   double
-  LinearSprings::elastic_energy(const ParticleSystem &system, const double *x) const
+  LinearSprings::elastic_energy(const ParticleSystem &, const double *x) const
   {
-    const SpringSet &all    = system.springs;
-    double           energy = 0;
-    for (std::size_t s = 0; s < all.size(); ++s)
-    {
-      const unsigned int i = 3 * all.a[s], j = 3 * all.b[s];
-      const double       len =
-        std::hypot(x[j] - x[i], x[j + 1] - x[i + 1], x[j + 2] - x[i + 2]);
-      energy += 0.5 * (stiffness_scale * all.stiffness[s]) * (len - all.rest_length[s])
-                * (len - all.rest_length[s]);
-    }
+    // Over the thread ranges, like the forces: a spring inside a range once, one
+    // between two ranges as a copy in each, counted half. The parts' sums are added in
+    // order, so the result depends on the partition but not on the threads' timing.
+    const unsigned int  parts = ranges.n_parts();
+    std::vector<double> part_energy(parts, 0.0);
+    ranges.for_each_part(
+      [&](const unsigned int p)
+      {
+        const auto energy_of = [x](const SpringSet &set, const double weight)
+        {
+          double sum = 0;
+          for (std::size_t s = 0; s < set.size(); ++s)
+          {
+            const unsigned int i = 3 * set.a[s], j = 3 * set.b[s];
+            const double       dx = x[j] - x[i], dy = x[j + 1] - x[i + 1],
+                         dz = x[j + 2] - x[i + 2];
+            const double stretch =
+              std::sqrt(dx * dx + dy * dy + dz * dz) - set.rest_length[s];
+            sum += set.stiffness[s] * stretch * stretch;
+          }
+          return 0.5 * weight * sum;
+        };
+        part_energy[p] =
+          energy_of(segments[2 * p].set, 1.0) + energy_of(segments[2 * p + 1].set, 0.5);
+      });
+    double energy = 0;
+    for (const double e : part_energy)
+      energy += e;
     return energy;
   }
 

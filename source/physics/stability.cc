@@ -183,8 +183,32 @@ namespace lacerta::physics
 
 
     /**
-     * Adds the terms of the spring between row @p p and particle @p q to row p of the
-     * weighted bound (weighted_frequency_bounds()): (1 + t) |K_e| to the row's @p block,
+     * What the weighted terms of a row need of one particle i with row weight d_i and
+     * mass m_i: up = d_i / sqrt(m_i), down = sqrt(m_i) / d_i and
+     * inverse = 1 / (sqrt(m_i) d_i), so that the terms of the spring between rows p and
+     * q take products only (add_weighted_spring_terms()).
+     */
+    struct RowFactors
+    {
+      double up, down, inverse;
+    };
+
+
+    /// The RowFactors of particle @p i with the row @p weights.
+    RowFactors
+    row_factors(const ParticleSystem      &system,
+                const std::vector<double> &weights,
+                const unsigned int         i)
+    {
+      const double root = std::sqrt(system.mass[i]);
+      return {weights[i] / root, root / weights[i], 1 / (root * weights[i])};
+    }
+
+
+    /**
+     * Adds the terms of the spring between row @p p and particle @p q (factors @p fp
+     * and @p fq, row_factors()) to row p of the weighted bound
+     * (weighted_frequency_bounds()): (1 + t) |K_e| to the row's @p block,
      * t = sqrt(m_p / m_q) d_q / d_p if both ends are free (0 if q is held), and the
      * norm @p element_norm of the force model's off-diagonal block on the edge, over
      * sqrt(m_p m_q) times d_q / d_p, to @p off_diagonal.
@@ -193,19 +217,19 @@ namespace lacerta::physics
     add_weighted_spring_terms(const ParticleSystem        &system,
                               const unsigned int           p,
                               const unsigned int           q,
-                              const std::vector<double>   &weights,
+                              const RowFactors            &fp,
+                              const RowFactors            &fq,
                               const std::array<double, 6> &absolute,
                               const double                 element_norm,
                               std::array<double, 6>       &block,
                               double                      &off_diagonal)
     {
       const bool   coupled = system.free[p] > 0 && system.free[q] > 0;
-      const double ratio   = coupled ? weights[q] / weights[p] : 0.0;
-      const double t = coupled ? std::sqrt(system.mass[p] / system.mass[q]) * ratio : 0.0;
+      const double t       = coupled ? fp.down * fq.up : 0.0;
       for (unsigned int c = 0; c < 6; ++c)
         block[c] += (1 + t) * absolute[c];
       if (coupled && element_norm > 0)
-        off_diagonal += element_norm / std::sqrt(system.mass[p] * system.mass[q]) * ratio;
+        off_diagonal += element_norm * (fq.up * fp.inverse);
     }
   } // namespace
 
@@ -434,7 +458,8 @@ namespace lacerta::physics
             add_weighted_spring_terms(system,
                                       p,
                                       q,
-                                      weights,
+                                      row_factors(system, weights, p),
+                                      row_factors(system, weights, q),
                                       w.spring_blocks[k],
                                       w.element_norm[k],
                                       w.row_blocks[r],
@@ -557,6 +582,9 @@ namespace lacerta::physics
     const unsigned int                 n = system.n_particles();
     std::vector<std::array<double, 6>> blocks(n, std::array<double, 6>{});
     std::vector<double>                off_diagonal(n, 0.0);
+    std::vector<RowFactors>            factors(n);
+    for (unsigned int i = 0; i < n; ++i)
+      factors[i] = row_factors(system, weights, i);
     for (std::size_t s = 0; s < system.springs.size(); ++s)
     {
       const unsigned int i = system.springs.a[s], j = system.springs.b[s];
@@ -564,7 +592,8 @@ namespace lacerta::physics
         add_weighted_spring_terms(system,
                                   p,
                                   q,
-                                  weights,
+                                  factors[p],
+                                  factors[q],
                                   terms.spring_block[s],
                                   terms.element_coupling[s],
                                   blocks[p],

@@ -19,6 +19,34 @@ namespace lacerta::physics
   }
 
 
+  std::optional<FrequencyBound>
+  StabilityBound::bound_with_kept_weights(const ParticleSystem &system) const
+  {
+    if (leaves == 0 || weights.size() != system.n_particles())
+      return std::nullopt;
+    const GershgorinTerms     terms = gershgorin_terms(system, system.position.data());
+    const std::vector<double> rows  = weighted_frequency_bounds(system, terms, weights);
+    // The highest row, the first among equals; one that is not a number wins (beats()).
+    FrequencyBound result;
+    double         highest = 0;
+    bool           found   = false;
+    for (unsigned int i = 0; i < rows.size(); ++i)
+      if (std::isnan(rows[i]) || (!std::isnan(highest) && rows[i] > highest))
+      {
+        highest         = rows[i];
+        found           = true;
+        result.particle = i;
+        if (std::isnan(highest))
+          break;
+      }
+    if (!found)
+      return result;
+    result.spring = terms.stiffest_spring[result.particle];
+    result.omega  = std::sqrt(highest);
+    return result;
+  }
+
+
   void
   StabilityBound::update(const ParticleSystem            &system,
                          const std::vector<unsigned int> &changed)

@@ -433,11 +433,30 @@ namespace lacerta
   Simulator::~Simulator() = default;
 
 
+  bool
+  Simulator::keeps_substeps(const physics::FrequencyBound &bound,
+                            const unsigned int             substeps) const
+  {
+    if (bound.omega == 0)
+      return true;
+    if (!std::isfinite(bound.omega))
+      return false;
+    const physics::ParticleSystem &system = *scene->system;
+    return time_step / substeps
+           <= safety_factor
+                * integrator->critical_time_step(bound.omega,
+                                                 system.mass_damping,
+                                                 system.spring_damping);
+  }
+
+
   unsigned int
   Simulator::choose_substeps(const physics::FrequencyBound &bound,
                              const unsigned int             current)
   {
     const physics::ParticleSystem &system = *scene->system;
+    if (current > 0 && keeps_substeps(bound, current))
+      return current;
     if (bound.omega == 0)
       return current > 0 ? current : 1;
     if (!std::isfinite(bound.omega))
@@ -448,8 +467,6 @@ namespace lacerta
     const double critical = integrator->critical_time_step(bound.omega,
                                                            system.mass_damping,
                                                            system.spring_damping);
-    if (current > 0 && time_step / current <= safety_factor * critical)
-      return current;
     std::cout << "Stability: highest eigenfrequency <= " << bound.omega
               << " rad/s (Gershgorin bound at particle " << bound.particle
               << "); critical time step " << critical << " s; time step " << time_step
@@ -761,11 +778,17 @@ namespace lacerta
       // The limit falls when an element collapses (the geometric stiffness of a
       // strongly compressed spring) without any change of the system: keeping the
       // sub-steps chosen at the last change let the severed kidney pole blow up.
+      // The bound with the row weights kept from the last change holds at the current
+      // positions and is at least the fresh one, so it decides alone while it allows
+      // the current sub-steps (the decision is then that of a fresh bound); only
+      // otherwise are the weights chosen again and the bound kept.
       if (substep_when_unstable)
-      {
-        stability_bound->compute(system);
-        state.substeps = choose_substeps(stability_bound->bound(), state.substeps);
-      }
+        if (const auto kept = stability_bound->bound_with_kept_weights(system);
+            !kept || !keeps_substeps(*kept, state.substeps))
+        {
+          stability_bound->compute(system);
+          state.substeps = choose_substeps(stability_bound->bound(), state.substeps);
+        }
     }
     if (needs_energies)
     {

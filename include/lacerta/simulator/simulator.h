@@ -202,6 +202,11 @@ namespace lacerta
     void
     evaluate_energies();
 
+    /// Whether @p substeps sub-steps per time step are stable under @p bound (0: nothing
+    /// moves; a bound that is not finite is not stable).
+    bool
+    keeps_substeps(const physics::FrequencyBound &bound, unsigned int substeps) const;
+
     /**
      * Checks the time step against the stability limit @p bound of the current state;
      * returns the sub-step count. @p current sub-steps, if given and still below the
