@@ -423,6 +423,12 @@ namespace lacerta::bench
         print_figure(prefix + "reextraction_cost_in_steps",
                      lod.reextraction_seconds / lod.step_seconds,
                      "");
+        // The same per 1 % of the level of detail swapped (the target: below 5).
+        if (lod.swapped_share > 0)
+          print_figure(prefix + "reextraction_cost_in_steps_per_percent",
+                       lod.reextraction_seconds / lod.step_seconds
+                         / (100 * lod.swapped_share),
+                       "");
         points.push_back({growth,
                           lod.tets,
                           full.seconds / lod.seconds,

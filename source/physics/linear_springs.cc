@@ -1,6 +1,7 @@
 // Force model `linear springs`: the paper's springs, f = k (|d| - L0) d/|d|.
 
 #include <lacerta/base/archive.h>
+#include <lacerta/base/sort_ids.h>
 #include <lacerta/physics/linear_springs.h>
 #include <lacerta/physics/particle_system.h>
 
@@ -160,15 +161,30 @@ namespace lacerta::physics
     // copies are the last of their segments), then the others in order (appended
     // ones go to the ends of their segments). A listed spring may have been
     // appended and removed again since (beyond both counts): it has no copies.
+    // A change lists a spring once per cell around it: each is taken once (by a stamp),
+    // then the few left are sorted.
+    const std::size_t known = std::max(known_springs, n_springs);
+    listed_stamp.resize(known, 0);
+    if (++listed_mark == 0)
+    {
+      std::fill(listed_stamp.begin(), listed_stamp.end(), 0);
+      listed_mark = 1;
+    }
     std::vector<unsigned int> listed;
-    listed.reserve(changed.size() + known_springs - std::min(known_springs, n_springs));
-    for (const unsigned int s : changed)
-      if (s < std::max(known_springs, n_springs))
+    const auto                list = [&](const unsigned int s)
+    {
+      if (s < known && listed_stamp[s] != listed_mark)
+      {
+        listed_stamp[s] = listed_mark;
         listed.push_back(s);
+      }
+    };
+    for (const unsigned int s : changed)
+      list(s);
     for (std::size_t s = n_springs; s < known_springs; ++s)
-      listed.push_back(static_cast<unsigned int>(s));
-    std::sort(listed.begin(), listed.end());
-    listed.erase(std::unique(listed.begin(), listed.end()), listed.end());
+      list(static_cast<unsigned int>(s));
+    std::vector<unsigned int> scratch;
+    sort_ids(listed, scratch);
     holders.resize(std::max(known_springs, n_springs), no_holders());
     // place() queues copies per segment; a restored model has none queued yet.
     pending_erase.resize(segments.size());

@@ -1,5 +1,6 @@
 #include <lacerta/base/archive.h>
 #include <lacerta/base/exceptions.h>
+#include <lacerta/base/sort_ids.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/force_model.h>
 #include <lacerta/physics/particle_system.h>
@@ -235,19 +236,24 @@ namespace lacerta::physics
 
 
   GershgorinTerms
-  gershgorin_terms(const ParticleSystem &system, const double *x)
+  gershgorin_terms(const ParticleSystem &system, const double *x, const bool unweighted)
   {
     const unsigned int n       = system.n_particles();
     const SpringSet   &springs = system.springs;
     // A system without a force model yet (a bare spring network) is bounded by its
     // springs as they are.
-    const double                       scale = spring_scale(system);
-    std::vector<std::array<double, 6>> blocks(n, std::array<double, 6>{});
-    std::vector<double>                pair_norm(springs.size(), 0.0);
-    std::vector<double>                element_norm(springs.size(), 0.0);
-    GershgorinTerms                    terms;
-    terms.diagonal.assign(n, 0.0);
-    terms.coupling.assign(springs.size(), 0.0);
+    const double scale = spring_scale(system);
+    // The sum of the tangent blocks at each particle, for the unweighted diagonal.
+    std::vector<std::array<double, 6>> blocks(unweighted ? n : 0,
+                                              std::array<double, 6>{});
+    std::vector<double> pair_norm(springs.size(), 0.0);
+    std::vector<double> element_norm(springs.size(), 0.0);
+    GershgorinTerms     terms;
+    if (unweighted)
+    {
+      terms.diagonal.assign(n, 0.0);
+      terms.coupling.assign(springs.size(), 0.0);
+    }
     terms.stiffest_spring.assign(n, 0);
     terms.spring_block.resize(springs.size());
     terms.element_block.assign(n, std::array<double, 6>{});
@@ -257,8 +263,11 @@ namespace lacerta::physics
     {
       const std::array<double, 6> block =
         spring_tangent_block(springs, s, x, scale, pair_norm[s], terms.spring_block[s]);
-      add_block(blocks[springs.a[s]], block);
-      add_block(blocks[springs.b[s]], block);
+      if (unweighted)
+      {
+        add_block(blocks[springs.a[s]], block);
+        add_block(blocks[springs.b[s]], block);
+      }
     }
     if (system.has_force_model())
       system.force_model().for_each_element_stiffness(
@@ -271,7 +280,8 @@ namespace lacerta::physics
             K,
             [&](unsigned int a, const std::array<double, 6> &b)
             {
-              add_block(blocks[tet[a]], b);
+              if (unweighted)
+                add_block(blocks[tet[a]], b);
               add_block(terms.element_block[tet[a]], b);
             },
             [&](unsigned int e, double norm)
@@ -287,7 +297,8 @@ namespace lacerta::physics
       const unsigned int i = springs.a[s], j = springs.b[s];
       if (system.free[i] > 0 && system.free[j] > 0)
       {
-        terms.coupling[s]         = pair_norm[s];
+        if (unweighted)
+          terms.coupling[s] = pair_norm[s];
         terms.element_coupling[s] = element_norm[s];
       }
       for (const unsigned int p : {i, j})
@@ -297,7 +308,7 @@ namespace lacerta::physics
           terms.stiffest_spring[p] = s;
         }
     }
-    for (unsigned int i = 0; i < n; ++i)
+    for (unsigned int i = 0; i < n && unweighted; ++i)
       terms.diagonal[i] = largest_eigenvalue(blocks[i]);
     return terms;
   }
@@ -305,33 +316,6 @@ namespace lacerta::physics
 
   namespace
   {
-    /**
-     * Sorts the ids @p ids in increasing order, by digits of 8 bits from the
-     * lowest (a radix sort: a few passes over them instead of a comparison sort's
-     * mispredicted branches), with @p scratch as room. Only the digits up to the
-     * highest bit set in any id are passed over.
-     */
-    void
-    sort_ids(std::vector<unsigned int> &ids, std::vector<unsigned int> &scratch)
-    {
-      unsigned int bits = 0;
-      for (const unsigned int id : ids)
-        bits |= id;
-      scratch.resize(ids.size());
-      for (unsigned int shift = 0; shift < 32 && (bits >> shift) != 0; shift += 8)
-      {
-        std::array<unsigned int, 257> start{};
-        for (const unsigned int id : ids)
-          ++start[((id >> shift) & 0xFFu) + 1];
-        for (unsigned int d = 1; d < 257; ++d)
-          start[d] += start[d - 1];
-        for (const unsigned int id : ids)
-          scratch[start[(id >> shift) & 0xFFu]++] = id;
-        ids.swap(scratch);
-      }
-    }
-
-
     /**
      * The mass-independent terms of the rows @p rows (distinct) into @p w: the
      * diagonal blocks Σ_e K_e of every row (w.blocks) and ||K_e|| of every spring at a

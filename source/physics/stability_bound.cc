@@ -24,8 +24,9 @@ namespace lacerta::physics
   {
     if (leaves == 0 || weights.size() != system.n_particles())
       return std::nullopt;
-    const GershgorinTerms     terms = gershgorin_terms(system, system.position.data());
-    const std::vector<double> rows  = weighted_frequency_bounds(system, terms, weights);
+    const GershgorinTerms terms =
+      gershgorin_terms(system, system.position.data(), /*unweighted=*/false);
+    const std::vector<double> rows = weighted_frequency_bounds(system, terms, weights);
     // The highest row, the first among equals; one that is not a number wins (beats()).
     FrequencyBound result;
     double         highest = 0;

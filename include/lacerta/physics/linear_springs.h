@@ -139,6 +139,10 @@ namespace lacerta::physics
       unsigned int s, from, to;
       double       stiffness, rest_length;
     };
+    /// springs_changed()'s marks of the springs it listed, `listed_mark` for this
+    /// change (scratch, not kept in a checkpoint).
+    std::vector<unsigned int> listed_stamp;
+    unsigned int              listed_mark = 0;
     /// Per segment: the springs whose copies leave it, and the copies that come.
     std::vector<std::vector<unsigned int>> pending_erase;
     std::vector<std::vector<PendingCopy>>  pending_insert;

@@ -62,9 +62,15 @@ namespace lacerta::physics
    * (ForceModel::for_each_element_stiffness()): the diagonal blocks of each element
    * stiffness, and the norm of each off-diagonal block added to the spring of its edge.
    * A system without a force model is bounded by its springs as they are.
+   * With @p unweighted false, `diagonal` and `coupling` (what only the unweighted
+   * bound, squared_frequency_bounds(), reads) are left empty: the weighted bound
+   * (weighted_frequency_bounds()) with given weights needs the rest, at about half the
+   * cost (the diagonal is an eigenvalue per particle).
    */
   GershgorinTerms
-  gershgorin_terms(const ParticleSystem &system, const double *positions);
+  gershgorin_terms(const ParticleSystem &system,
+                   const double         *positions,
+                   bool                  unweighted = true);
 
   /**
    * The squared block Gershgorin row bounds λ_i = diagonal[i] / m_i
