@@ -185,7 +185,7 @@ namespace lacerta::physics
       list(static_cast<unsigned int>(s));
     std::vector<unsigned int> scratch;
     sort_ids(listed, scratch);
-    holders.resize(std::max(known_springs, n_springs), no_holders());
+    holders.resize(known, no_holders());
     // place() queues copies per segment; a restored model has none queued yet.
     pending_erase.resize(segments.size());
     pending_insert.resize(segments.size());
@@ -248,8 +248,7 @@ namespace lacerta::physics
     // Over the thread ranges, like the forces: a spring inside a range once, one
     // between two ranges as a copy in each, counted half. The parts' sums are added in
     // order, so the result depends on the partition but not on the threads' timing.
-    const unsigned int  parts = ranges.n_parts();
-    std::vector<double> part_energy(parts, 0.0);
+    part_energy.assign(ranges.n_parts(), 0.0);
     ranges.for_each_part(
       [&](const unsigned int p)
       {

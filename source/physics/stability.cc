@@ -184,31 +184,41 @@ namespace lacerta::physics
 
 
     /**
-     * What the weighted terms of a row need of one particle i with row weight d_i and
-     * mass m_i: up = d_i / sqrt(m_i), down = sqrt(m_i) / d_i and
-     * inverse = 1 / (sqrt(m_i) d_i), so that the terms of the spring between rows p and
-     * q take products only (add_weighted_spring_terms()).
+     * What the weighted terms of row p need of its own particle, with row weight d_p
+     * and mass m_p: down = sqrt(m_p) / d_p and inverse = 1 / (sqrt(m_p) d_p); of the
+     * other end q of a spring they need up_factor(q) = d_q / sqrt(m_q). The terms then
+     * take products only (add_weighted_spring_terms()).
      */
     struct RowFactors
     {
-      double up, down, inverse;
+      double down, inverse;
     };
 
 
-    /// The RowFactors of particle @p i with the row @p weights.
+    /// The RowFactors of particle @p p with the row @p weights.
     RowFactors
     row_factors(const ParticleSystem      &system,
                 const std::vector<double> &weights,
-                const unsigned int         i)
+                const unsigned int         p)
     {
-      const double root = std::sqrt(system.mass[i]);
-      return {weights[i] / root, root / weights[i], 1 / (root * weights[i])};
+      const double root = std::sqrt(system.mass[p]);
+      return {root / weights[p], 1 / (root * weights[p])};
+    }
+
+
+    /// d_q / sqrt(m_q) of particle @p q with the row @p weights (RowFactors).
+    double
+    up_factor(const ParticleSystem      &system,
+              const std::vector<double> &weights,
+              const unsigned int         q)
+    {
+      return weights[q] / std::sqrt(system.mass[q]);
     }
 
 
     /**
-     * Adds the terms of the spring between row @p p and particle @p q (factors @p fp
-     * and @p fq, row_factors()) to row p of the weighted bound
+     * Adds the terms of the spring between row @p p and particle @p q (the row's
+     * factors @p fp, q's up_factor() @p up_q) to row p of the weighted bound
      * (weighted_frequency_bounds()): (1 + t) |K_e| to the row's @p block,
      * t = sqrt(m_p / m_q) d_q / d_p if both ends are free (0 if q is held), and the
      * norm @p element_norm of the force model's off-diagonal block on the edge, over
@@ -219,18 +229,18 @@ namespace lacerta::physics
                               const unsigned int           p,
                               const unsigned int           q,
                               const RowFactors            &fp,
-                              const RowFactors            &fq,
+                              const double                 up_q,
                               const std::array<double, 6> &absolute,
                               const double                 element_norm,
                               std::array<double, 6>       &block,
                               double                      &off_diagonal)
     {
       const bool   coupled = system.free[p] > 0 && system.free[q] > 0;
-      const double t       = coupled ? fp.down * fq.up : 0.0;
+      const double t       = coupled ? fp.down * up_q : 0.0;
       for (unsigned int c = 0; c < 6; ++c)
         block[c] += (1 + t) * absolute[c];
       if (coupled && element_norm > 0)
-        off_diagonal += element_norm * (fq.up * fp.inverse);
+        off_diagonal += element_norm * (up_q * fp.inverse);
     }
   } // namespace
 
@@ -430,6 +440,14 @@ namespace lacerta::physics
       w.row_blocks.assign(n, std::array<double, 6>{});
       w.off_diagonal.assign(n, 0.0);
       w.stiffest.assign(n, 0.0);
+      w.row_down.resize(n);
+      w.row_inverse.resize(n);
+      for (std::size_t r = 0; r < n; ++r)
+      {
+        const RowFactors f = row_factors(system, weights, rows[r]);
+        w.row_down[r]      = f.down;
+        w.row_inverse[r]   = f.inverse;
+      }
       for (std::size_t r = 0; r < n && stiffest_spring != nullptr; ++r)
         stiffest_spring[r] = 0;
       for (std::size_t k = 0; k < w.springs.size(); ++k)
@@ -442,8 +460,8 @@ namespace lacerta::physics
             add_weighted_spring_terms(system,
                                       p,
                                       q,
-                                      row_factors(system, weights, p),
-                                      row_factors(system, weights, q),
+                                      RowFactors{w.row_down[r], w.row_inverse[r]},
+                                      up_factor(system, weights, q),
                                       w.spring_blocks[k],
                                       w.element_norm[k],
                                       w.row_blocks[r],
@@ -567,8 +585,12 @@ namespace lacerta::physics
     std::vector<std::array<double, 6>> blocks(n, std::array<double, 6>{});
     std::vector<double>                off_diagonal(n, 0.0);
     std::vector<RowFactors>            factors(n);
+    std::vector<double>                up(n);
     for (unsigned int i = 0; i < n; ++i)
+    {
       factors[i] = row_factors(system, weights, i);
+      up[i]      = up_factor(system, weights, i);
+    }
     for (std::size_t s = 0; s < system.springs.size(); ++s)
     {
       const unsigned int i = system.springs.a[s], j = system.springs.b[s];
@@ -577,7 +599,7 @@ namespace lacerta::physics
                                   p,
                                   q,
                                   factors[p],
-                                  factors[q],
+                                  up[q],
                                   terms.spring_block[s],
                                   terms.element_coupling[s],
                                   blocks[p],

@@ -7,6 +7,25 @@
 
 namespace lacerta::physics
 {
+  namespace
+  {
+    /**
+     * Whether row @p a with bound @p lambda_a beats row @p b with @p lambda_b: higher,
+     * or equal and first. A bound that is not a number wins (the caller reports it).
+     */
+    bool
+    higher_row(const double       lambda_a,
+               const unsigned int a,
+               const double       lambda_b,
+               const unsigned int b)
+    {
+      if (std::isnan(lambda_a) || std::isnan(lambda_b))
+        return std::isnan(lambda_a) && (!std::isnan(lambda_b) || a < b);
+      return lambda_a > lambda_b || (lambda_a == lambda_b && a < b);
+    }
+  } // namespace
+
+
   void
   StabilityBound::compute(const ParticleSystem &system)
   {
@@ -27,23 +46,17 @@ namespace lacerta::physics
     const GershgorinTerms terms =
       gershgorin_terms(system, system.position.data(), /*unweighted=*/false);
     const std::vector<double> rows = weighted_frequency_bounds(system, terms, weights);
-    // The highest row, the first among equals; one that is not a number wins (beats()).
+    // The highest row, as bound() picks it from the kept rows.
+    unsigned int best = 0;
+    for (unsigned int i = 1; i < rows.size(); ++i)
+      if (higher_row(rows[i], i, rows[best], best))
+        best = i;
     FrequencyBound result;
-    double         highest = 0;
-    bool           found   = false;
-    for (unsigned int i = 0; i < rows.size(); ++i)
-      if (std::isnan(rows[i]) || (!std::isnan(highest) && rows[i] > highest))
-      {
-        highest         = rows[i];
-        found           = true;
-        result.particle = i;
-        if (std::isnan(highest))
-          break;
-      }
-    if (!found)
+    if (rows.empty() || (!(rows[best] > 0) && !std::isnan(rows[best])))
       return result;
-    result.spring = terms.stiffest_spring[result.particle];
-    result.omega  = std::sqrt(highest);
+    result.particle = best;
+    result.spring   = terms.stiffest_spring[best];
+    result.omega    = std::sqrt(rows[best]);
     return result;
   }
 
@@ -179,9 +192,7 @@ namespace lacerta::physics
     if (b == none)
       return true;
     // A bound that is not a number wins: the caller reports it.
-    if (std::isnan(lambda[a]) || std::isnan(lambda[b]))
-      return std::isnan(lambda[a]) && (!std::isnan(lambda[b]) || a < b);
-    return lambda[a] > lambda[b] || (lambda[a] == lambda[b] && a < b);
+    return higher_row(lambda[a], a, lambda[b], b);
   }
 
 

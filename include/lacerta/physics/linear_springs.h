@@ -139,6 +139,9 @@ namespace lacerta::physics
       unsigned int s, from, to;
       double       stiffness, rest_length;
     };
+    /// elastic_energy()'s sum per range (scratch, so that the statistics' energy at
+    /// every step allocates nothing).
+    mutable std::vector<double> part_energy;
     /// springs_changed()'s marks of the springs it listed, `listed_mark` for this
     /// change (scratch, not kept in a checkpoint).
     std::vector<unsigned int> listed_stamp;

@@ -177,6 +177,8 @@ namespace lacerta::physics
     /// rows weighted anew with their first weights.
     std::vector<std::array<double, 6>> row_blocks;
     std::vector<double>                refined;
+    /// sqrt(m_i) / d_i and 1 / (sqrt(m_i) d_i) of the rows being summed.
+    std::vector<double> row_down, row_inverse;
   };
 
   /**
