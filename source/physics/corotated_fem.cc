@@ -180,6 +180,12 @@ namespace lacerta::physics
         return energy;
       }
 
+      const ParticleRanges &
+      particle_ranges() const override
+      {
+        return ranges;
+      }
+
       double
       spring_stiffness_scale() const override
       {

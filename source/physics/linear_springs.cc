@@ -126,6 +126,13 @@ namespace lacerta::physics
   }
 
 
+  const ParticleRanges &
+  LinearSprings::particle_ranges() const
+  {
+    return ranges;
+  }
+
+
   void
   LinearSprings::initialize(const ParticleSystem &system, const unsigned int n_threads)
   {

@@ -3,6 +3,7 @@
 #include <lacerta/base/sort_ids.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/force_model.h>
+#include <lacerta/physics/particle_ranges.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/stability.h>
 
@@ -10,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <sstream>
+#include <tuple>
 
 namespace lacerta::physics
 {
@@ -146,6 +148,65 @@ namespace lacerta::physics
     }
 
 
+    /**
+     * The force model's thread ranges if they cover the system's particles, so that
+     * work spread over them runs on the model's threads (as many as the run asked
+     * for); nullptr without a model or with one range: the work runs in one part.
+     */
+    const ParticleRanges *
+    thread_ranges(const ParticleSystem &system)
+    {
+      if (!system.has_force_model())
+        return nullptr;
+      const ParticleRanges &ranges = system.force_model().particle_ranges();
+      const unsigned int    parts  = ranges.n_parts();
+      if (parts < 2 || ranges.begin(0) != 0
+          || ranges.end(parts - 1) != system.n_particles())
+        return nullptr;
+      return &ranges;
+    }
+
+
+    /**
+     * Runs @p work(begin, end) over contiguous ranges of the system's particles that
+     * together cover them once, in parallel on the force model's threads. A pass over
+     * the springs that adds to a row only in the range of its particle adds every row's
+     * terms in spring order, as one pass over all rows would: the same sums to the bit
+     * on any number of threads, without atomics.
+     */
+    template <typename Work>
+    void
+    for_each_particle_range(const ParticleSystem &system, const Work &work)
+    {
+      if (const ParticleRanges *ranges = thread_ranges(system))
+        ranges->for_each_part([&](const unsigned int p)
+                              { work(ranges->begin(p), ranges->end(p)); });
+      else
+        work(0u, system.n_particles());
+    }
+
+
+    /**
+     * Runs @p work(begin, end) over contiguous ranges of the system's springs that
+     * together cover them once, in parallel on the force model's threads (for work
+     * that writes only the springs' own entries).
+     */
+    template <typename Work>
+    void
+    for_each_spring_range(const ParticleSystem &system, const Work &work)
+    {
+      const std::size_t n = system.springs.size();
+      if (const ParticleRanges *ranges = thread_ranges(system))
+      {
+        const std::size_t parts = ranges->n_parts();
+        ranges->for_each_part([&](const unsigned int p)
+                              { work(n * p / parts, n * (p + 1) / parts); });
+      }
+      else
+        work(std::size_t(0), n);
+    }
+
+
     /// Whether particle @p i has a row in the bound: free, with a mass.
     bool
     has_row(const ParticleSystem &system, const unsigned int i)
@@ -246,39 +307,45 @@ namespace lacerta::physics
 
 
   GershgorinTerms
-  gershgorin_terms(const ParticleSystem &system, const double *x, const bool unweighted)
+  gershgorin_terms(const ParticleSystem &system, const double *x)
   {
     const unsigned int n       = system.n_particles();
     const SpringSet   &springs = system.springs;
     // A system without a force model yet (a bare spring network) is bounded by its
     // springs as they are.
     const double scale = spring_scale(system);
-    // The sum of the tangent blocks at each particle, for the unweighted diagonal.
-    std::vector<std::array<double, 6>> blocks(unweighted ? n : 0,
-                                              std::array<double, 6>{});
-    std::vector<double> pair_norm(springs.size(), 0.0);
-    std::vector<double> element_norm(springs.size(), 0.0);
-    GershgorinTerms     terms;
-    if (unweighted)
-    {
-      terms.diagonal.assign(n, 0.0);
-      terms.coupling.assign(springs.size(), 0.0);
-    }
+    // The tangent block of each spring, and their sum at each particle.
+    std::vector<std::array<double, 6>> tangent(springs.size());
+    std::vector<std::array<double, 6>> blocks(n, std::array<double, 6>{});
+    std::vector<double>                pair_norm(springs.size(), 0.0);
+    std::vector<double>                element_norm(springs.size(), 0.0);
+    GershgorinTerms                    terms;
+    terms.diagonal.assign(n, 0.0);
+    terms.coupling.assign(springs.size(), 0.0);
     terms.stiffest_spring.assign(n, 0);
     terms.spring_block.resize(springs.size());
     terms.element_block.assign(n, std::array<double, 6>{});
     terms.element_coupling.assign(springs.size(), 0.0);
 
-    for (std::size_t s = 0; s < springs.size(); ++s)
-    {
-      const std::array<double, 6> block =
-        spring_tangent_block(springs, s, x, scale, pair_norm[s], terms.spring_block[s]);
-      if (unweighted)
-      {
-        add_block(blocks[springs.a[s]], block);
-        add_block(blocks[springs.b[s]], block);
-      }
-    }
+    for_each_spring_range(system,
+                          [&](const std::size_t begin, const std::size_t end)
+                          {
+                            for (std::size_t s = begin; s < end; ++s)
+                              tangent[s] = spring_tangent_block(springs,
+                                                                s,
+                                                                x,
+                                                                scale,
+                                                                pair_norm[s],
+                                                                terms.spring_block[s]);
+                          });
+    for_each_particle_range(system,
+                            [&](const unsigned int begin, const unsigned int end)
+                            {
+                              for (std::size_t s = 0; s < springs.size(); ++s)
+                                for (const unsigned int p : {springs.a[s], springs.b[s]})
+                                  if (p >= begin && p < end)
+                                    add_block(blocks[p], tangent[s]);
+                            });
     if (system.has_force_model())
       system.force_model().for_each_element_stiffness(
         system,
@@ -290,8 +357,7 @@ namespace lacerta::physics
             K,
             [&](unsigned int a, const std::array<double, 6> &b)
             {
-              if (unweighted)
-                add_block(blocks[tet[a]], b);
+              add_block(blocks[tet[a]], b);
               add_block(terms.element_block[tet[a]], b);
             },
             [&](unsigned int e, double norm)
@@ -301,25 +367,35 @@ namespace lacerta::physics
             });
         });
 
-    std::vector<double> stiffest(n, 0.0);
-    for (std::size_t s = 0; s < springs.size(); ++s)
-    {
-      const unsigned int i = springs.a[s], j = springs.b[s];
-      if (system.free[i] > 0 && system.free[j] > 0)
-      {
-        if (unweighted)
-          terms.coupling[s] = pair_norm[s];
-        terms.element_coupling[s] = element_norm[s];
-      }
-      for (const unsigned int p : {i, j})
-        if (pair_norm[s] > stiffest[p])
-        {
-          stiffest[p]              = pair_norm[s];
-          terms.stiffest_spring[p] = s;
-        }
-    }
-    for (unsigned int i = 0; i < n && unweighted; ++i)
-      terms.diagonal[i] = largest_eigenvalue(blocks[i]);
+    for_each_spring_range(system,
+                          [&](const std::size_t begin, const std::size_t end)
+                          {
+                            for (std::size_t s = begin; s < end; ++s)
+                              if (system.free[springs.a[s]] > 0
+                                  && system.free[springs.b[s]] > 0)
+                              {
+                                terms.coupling[s]         = pair_norm[s];
+                                terms.element_coupling[s] = element_norm[s];
+                              }
+                          });
+    for_each_particle_range(system,
+                            [&](const unsigned int begin, const unsigned int end)
+                            {
+                              // The first of the springs with the largest norm at each
+                              // particle.
+                              std::vector<double> stiffest(end - begin, 0.0);
+                              for (std::size_t s = 0; s < springs.size(); ++s)
+                                for (const unsigned int p : {springs.a[s], springs.b[s]})
+                                  if (p >= begin && p < end
+                                      && pair_norm[s] > stiffest[p - begin])
+                                  {
+                                    stiffest[p - begin] = pair_norm[s];
+                                    terms.stiffest_spring[p] =
+                                      static_cast<unsigned int>(s);
+                                  }
+                              for (unsigned int i = begin; i < end; ++i)
+                                terms.diagonal[i] = largest_eigenvalue(blocks[i]);
+                            });
     return terms;
   }
 
@@ -558,22 +634,133 @@ namespace lacerta::physics
   std::vector<double>
   squared_frequency_bounds(const ParticleSystem &system, const GershgorinTerms &terms)
   {
-    const unsigned int  n = system.n_particles();
-    std::vector<double> off_diagonal(n, 0.0);
-    for (std::size_t s = 0; s < system.springs.size(); ++s)
-      if (terms.coupling[s] > 0)
-      {
-        const unsigned int i = system.springs.a[s], j = system.springs.b[s];
-        const double c = terms.coupling[s] / std::sqrt(system.mass[i] * system.mass[j]);
-        off_diagonal[i] += c;
-        off_diagonal[j] += c;
-      }
-    std::vector<double> lambda(n, 0.0);
-    for (unsigned int i = 0; i < n; ++i)
-      if (has_row(system, i))
-        lambda[i] = terms.diagonal[i] / system.mass[i] + off_diagonal[i];
+    const SpringSet    &springs = system.springs;
+    std::vector<double> lambda(system.n_particles(), 0.0);
+    for_each_particle_range(system,
+                            [&](const unsigned int begin, const unsigned int end)
+                            {
+                              // lambda first holds the off-diagonal sums.
+                              for (std::size_t s = 0; s < springs.size(); ++s)
+                                if (terms.coupling[s] > 0)
+                                {
+                                  const unsigned int i = springs.a[s], j = springs.b[s];
+                                  if ((i < begin || i >= end) && (j < begin || j >= end))
+                                    continue;
+                                  const double c =
+                                    terms.coupling[s]
+                                    / std::sqrt(system.mass[i] * system.mass[j]);
+                                  for (const unsigned int p : {i, j})
+                                    if (p >= begin && p < end)
+                                      lambda[p] += c;
+                                }
+                              for (unsigned int i = begin; i < end; ++i)
+                                lambda[i] =
+                                  has_row(system, i)
+                                    ? terms.diagonal[i] / system.mass[i] + lambda[i]
+                                    : 0.0;
+                            });
     return lambda;
   }
+
+
+  namespace
+  {
+    /// What the weighted rows read of one spring (weighted_rows_of_range()).
+    struct SpringRowTerms
+    {
+      /// Its block |K_e|.
+      const std::array<double, 6> &absolute;
+      /// The bound of ||K_e|| with the force model's off-diagonal norm on its edge.
+      double pair_norm;
+      /// That off-diagonal norm if both ends are free, 0 otherwise.
+      double element_coupling;
+    };
+
+
+    /**
+     * The squared rows λ_i of weighted_frequency_bounds() with the row @p factors and
+     * @p up factors for the particles i in [@p begin, @p end) into @p lambda, and the
+     * first of the springs with the largest pair norm at each into @p stiffest (if not
+     * null): one pass over the springs that adds, in spring order, the terms
+     * @p spring_terms(s) (a SpringRowTerms) of every spring with an end in the range to
+     * that end's row, then the force model's diagonal @p element_block (none if
+     * empty).
+     */
+    template <typename SpringTerms>
+    void
+    weighted_rows_of_range(const ParticleSystem                     &system,
+                           const std::vector<RowFactors>            &factors,
+                           const std::vector<double>                &up,
+                           const std::vector<std::array<double, 6>> &element_block,
+                           const unsigned int                        begin,
+                           const unsigned int                        end,
+                           const SpringTerms                        &spring_terms,
+                           double                                   *lambda,
+                           unsigned int                             *stiffest)
+    {
+      const SpringSet                   &springs = system.springs;
+      std::vector<std::array<double, 6>> blocks(end - begin, std::array<double, 6>{});
+      std::vector<double>                off_diagonal(end - begin, 0.0);
+      std::vector<double>                largest(stiffest ? end - begin : 0, 0.0);
+      for (std::size_t s = 0; s < springs.size(); ++s)
+      {
+        const unsigned int i = springs.a[s], j = springs.b[s];
+        const bool         has_i = i >= begin && i < end, has_j = j >= begin && j < end;
+        if (!has_i && !has_j)
+          continue;
+        const SpringRowTerms terms = spring_terms(s);
+        for (const auto &[p, q, has_p] :
+             {std::tuple{i, j, has_i}, std::tuple{j, i, has_j}})
+        {
+          if (!has_p)
+            continue;
+          add_weighted_spring_terms(system,
+                                    p,
+                                    q,
+                                    factors[p],
+                                    up[q],
+                                    terms.absolute,
+                                    terms.element_coupling,
+                                    blocks[p - begin],
+                                    off_diagonal[p - begin]);
+          if (stiffest != nullptr && terms.pair_norm > largest[p - begin])
+          {
+            largest[p - begin] = terms.pair_norm;
+            stiffest[p]        = static_cast<unsigned int>(s);
+          }
+        }
+      }
+      const std::array<double, 6> none{};
+      for (unsigned int i = begin; i < end; ++i)
+        lambda[i] = has_row(system, i)
+                      ? row_block_bound(blocks[i - begin],
+                                        element_block.empty() ? none : element_block[i])
+                            / system.mass[i]
+                          + off_diagonal[i - begin]
+                      : 0.0;
+    }
+
+
+    /// The RowFactors and up_factor() of every particle with the row @p weights.
+    void
+    all_row_factors(const ParticleSystem      &system,
+                    const std::vector<double> &weights,
+                    std::vector<RowFactors>   &factors,
+                    std::vector<double>       &up)
+    {
+      factors.resize(system.n_particles());
+      up.resize(system.n_particles());
+      for_each_particle_range(system,
+                              [&](const unsigned int begin, const unsigned int end)
+                              {
+                                for (unsigned int i = begin; i < end; ++i)
+                                {
+                                  factors[i] = row_factors(system, weights, i);
+                                  up[i]      = up_factor(system, weights, i);
+                                }
+                              });
+    }
+  } // namespace
 
 
   std::vector<double>
@@ -581,35 +768,97 @@ namespace lacerta::physics
                             const GershgorinTerms     &terms,
                             const std::vector<double> &weights)
   {
-    const unsigned int                 n = system.n_particles();
-    std::vector<std::array<double, 6>> blocks(n, std::array<double, 6>{});
-    std::vector<double>                off_diagonal(n, 0.0);
-    std::vector<RowFactors>            factors(n);
-    std::vector<double>                up(n);
-    for (unsigned int i = 0; i < n; ++i)
-    {
-      factors[i] = row_factors(system, weights, i);
-      up[i]      = up_factor(system, weights, i);
-    }
-    for (std::size_t s = 0; s < system.springs.size(); ++s)
-    {
-      const unsigned int i = system.springs.a[s], j = system.springs.b[s];
-      for (const auto &[p, q] : {std::pair{i, j}, std::pair{j, i}})
-        add_weighted_spring_terms(system,
-                                  p,
-                                  q,
-                                  factors[p],
-                                  up[q],
-                                  terms.spring_block[s],
-                                  terms.element_coupling[s],
-                                  blocks[p],
-                                  off_diagonal[p]);
-    }
+    std::vector<RowFactors> factors;
+    std::vector<double>     up;
+    // Every row reads the up factors of its neighbours in other ranges: all are set
+    // before the first row adds its springs.
+    all_row_factors(system, weights, factors, up);
+    std::vector<double> lambda(system.n_particles(), 0.0);
+    for_each_particle_range(
+      system,
+      [&](const unsigned int begin, const unsigned int end)
+      {
+        weighted_rows_of_range(
+          system,
+          factors,
+          up,
+          terms.element_block,
+          begin,
+          end,
+          [&](const std::size_t s) {
+            return SpringRowTerms{terms.spring_block[s], 0.0, terms.element_coupling[s]};
+          },
+          lambda.data(),
+          nullptr);
+      });
+    return lambda;
+  }
+
+
+  std::vector<double>
+  weighted_frequency_bounds_at(const ParticleSystem      &system,
+                               const double              *x,
+                               const std::vector<double> &weights,
+                               std::vector<unsigned int> &stiffest_spring)
+  {
+    const unsigned int n       = system.n_particles();
+    const SpringSet   &springs = system.springs;
+    const double       scale   = spring_scale(system);
+    // The force model's element terms, as gershgorin_terms() adds them (arrays only if
+    // the model has elements).
+    std::vector<std::array<double, 6>> element_block;
+    std::vector<double>                element_norm;
+    if (system.has_force_model())
+      system.force_model().for_each_element_stiffness(
+        system,
+        x,
+        [&](const unsigned int t, const ForceModel::ElementStiffness &K)
+        {
+          if (element_block.empty())
+          {
+            element_block.assign(n, std::array<double, 6>{});
+            element_norm.assign(springs.size(), 0.0);
+          }
+          const mesh::Tet &tet = system.mesh->tet(t);
+          element_terms(
+            K,
+            [&](unsigned int a, const std::array<double, 6> &b)
+            { add_block(element_block[tet[a]], b); },
+            [&](unsigned int e, double norm)
+            { element_norm[system.mesh->tet_edges(t)[e]] += norm; });
+        });
+    std::vector<RowFactors> factors;
+    std::vector<double>     up;
+    all_row_factors(system, weights, factors, up);
     std::vector<double> lambda(n, 0.0);
-    for (unsigned int i = 0; i < n; ++i)
-      if (has_row(system, i))
-        lambda[i] = row_block_bound(blocks[i], terms.element_block[i]) / system.mass[i]
-                    + off_diagonal[i];
+    stiffest_spring.assign(n, 0);
+    for_each_particle_range(
+      system,
+      [&](const unsigned int begin, const unsigned int end)
+      {
+        // Each range works out the terms of its springs itself: a spring between two
+        // ranges twice, to the same bits.
+        std::array<double, 6> absolute;
+        weighted_rows_of_range(
+          system,
+          factors,
+          up,
+          element_block,
+          begin,
+          end,
+          [&](const std::size_t s)
+          {
+            double norm = 0;
+            spring_tangent_block(springs, s, x, scale, norm, absolute);
+            double       element   = element_norm.empty() ? 0.0 : element_norm[s];
+            const double pair_norm = norm + element;
+            if (!(system.free[springs.a[s]] > 0 && system.free[springs.b[s]] > 0))
+              element = 0;
+            return SpringRowTerms{absolute, pair_norm, element};
+          },
+          lambda.data(),
+          stiffest_spring.data());
+      });
     return lambda;
   }
 

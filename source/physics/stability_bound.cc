@@ -43,9 +43,11 @@ namespace lacerta::physics
   {
     if (leaves == 0 || weights.size() != system.n_particles())
       return std::nullopt;
-    const GershgorinTerms terms =
-      gershgorin_terms(system, system.position.data(), /*unweighted=*/false);
-    const std::vector<double> rows = weighted_frequency_bounds(system, terms, weights);
+    std::vector<unsigned int> stiffest_spring;
+    const std::vector<double> rows = weighted_frequency_bounds_at(system,
+                                                                  system.position.data(),
+                                                                  weights,
+                                                                  stiffest_spring);
     // The highest row, as bound() picks it from the kept rows.
     unsigned int best = 0;
     for (unsigned int i = 1; i < rows.size(); ++i)
@@ -55,7 +57,7 @@ namespace lacerta::physics
     if (rows.empty() || (!(rows[best] > 0) && !std::isnan(rows[best])))
       return result;
     result.particle = best;
-    result.spring   = terms.stiffest_spring[best];
+    result.spring   = stiffest_spring[best];
     result.omega    = std::sqrt(rows[best]);
     return result;
   }

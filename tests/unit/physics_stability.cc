@@ -2,7 +2,9 @@
 // against the true limit from an eigen-solver, and blow-up detection.
 
 #include <lacerta/base/exceptions.h>
+#include <lacerta/physics/force_model.h>
 #include <lacerta/physics/integrator.h>
+#include <lacerta/physics/particle_ranges.h>
 #include <lacerta/physics/stability.h>
 
 #include <gtest/gtest.h>
@@ -429,4 +431,69 @@ TEST(Stability, MultirateShareCountsEachSpringAtItsOwnStep)
   // Equal particles: nothing to save.
   system.mass = {1, 1, 1, 1, 1, 1};
   EXPECT_DOUBLE_EQ(physics::multirate_evaluation_share(system), 1.0);
+}
+
+
+TEST(Stability, BoundsOnSeveralThreadsEqualThoseOnOneToTheBit)
+{
+  // The bound's passes over the whole system run in the force model's thread ranges,
+  // each adding its rows' terms in spring order: the same sums as on one thread.
+  // (Corotated FEM visits its tetrahedra range by range, so its element terms are
+  // summed in another order on another number of threads.)
+  const mesh::TetMesh mesh =
+    test_support::distorted_box(6, 0.2, dealii::Point<3>(0.1, 0.1, 0.1));
+  for (const std::string model : {"linear springs", "volume springs"})
+  {
+    SCOPED_TRACE(model);
+    auto serial = test_support::make_system(mesh, 1000, 1e5, 1, model);
+    auto dual   = test_support::make_system(mesh, 1000, 1e5, 2, model);
+    ASSERT_GT(dual->force_model().particle_ranges().n_parts(), 1u);
+    perturb(serial->position, 0.002, 5);
+    perturb(serial->mass, 1e-4, 7);
+    for (unsigned int i = 0; i < serial->n_particles(); i += 17)
+      serial->free[i] = 0;
+    dual->position = serial->position;
+    dual->mass     = serial->mass;
+    dual->free     = serial->free;
+    std::vector<double>                    weights(serial->n_particles());
+    std::mt19937                           random(8);
+    std::uniform_real_distribution<double> log_weight(-2, 2);
+    for (double &w : weights)
+      w = std::exp(log_weight(random));
+
+    {
+      const physics::GershgorinTerms one =
+        physics::gershgorin_terms(*serial, serial->position.data());
+      const physics::GershgorinTerms two =
+        physics::gershgorin_terms(*dual, dual->position.data());
+      EXPECT_EQ(one.diagonal, two.diagonal);
+      EXPECT_EQ(one.coupling, two.coupling);
+      EXPECT_EQ(one.stiffest_spring, two.stiffest_spring);
+      EXPECT_EQ(one.spring_block, two.spring_block);
+      EXPECT_EQ(one.element_block, two.element_block);
+      EXPECT_EQ(one.element_coupling, two.element_coupling);
+      EXPECT_EQ(physics::weighted_frequency_bounds(*serial, one, weights),
+                physics::weighted_frequency_bounds(*dual, two, weights));
+      EXPECT_EQ(physics::squared_frequency_bounds(*serial, one),
+                physics::squared_frequency_bounds(*dual, two));
+    }
+    // The rows of the periodic check, made without keeping the springs' terms.
+    const physics::GershgorinTerms terms =
+      physics::gershgorin_terms(*serial, serial->position.data());
+    const std::vector<double> rows =
+      physics::weighted_frequency_bounds(*serial, terms, weights);
+    for (const auto *system : {serial.get(), dual.get()})
+    {
+      std::vector<unsigned int> stiffest;
+      EXPECT_EQ(physics::weighted_frequency_bounds_at(
+                  *system, system->position.data(), weights, stiffest),
+                rows);
+      EXPECT_EQ(stiffest, terms.stiffest_spring);
+    }
+    const physics::FrequencyBound one = physics::bound_highest_frequency(*serial);
+    const physics::FrequencyBound two = physics::bound_highest_frequency(*dual);
+    EXPECT_EQ(one.omega, two.omega);
+    EXPECT_EQ(one.particle, two.particle);
+    EXPECT_EQ(one.spring, two.spring);
+  }
 }

@@ -18,6 +18,7 @@ namespace lacerta
 }
 namespace lacerta::physics
 {
+  class ParticleRanges;
   class ParticleSystem;
 
   /**
@@ -103,6 +104,15 @@ namespace lacerta::physics
     /// Writes or reads the model's state for a checkpoint (see lacerta::Archive).
     virtual void
     serialize(Archive &archive) = 0;
+
+    /**
+     * The particle ranges the model's threads work in (made by initialize() for its
+     * thread count, extended by springs_changed()). Work over the whole system that
+     * is not the model's own (the stability bound's periodic check) runs in them, on
+     * the same threads.
+     */
+    virtual const ParticleRanges &
+    particle_ranges() const = 0;
 
     /// A 12x12 tangent stiffness of a tetrahedron, rows and columns ordered (local
     /// vertex, component), row-major.

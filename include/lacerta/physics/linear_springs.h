@@ -71,6 +71,9 @@ namespace lacerta::physics
     double
     spring_stiffness_scale() const override;
 
+    const ParticleRanges &
+    particle_ranges() const override;
+
   protected:
     /**
      * Zeroes the forces of range @p p's particles and adds the forces of its springs

@@ -62,15 +62,9 @@ namespace lacerta::physics
    * (ForceModel::for_each_element_stiffness()): the diagonal blocks of each element
    * stiffness, and the norm of each off-diagonal block added to the spring of its edge.
    * A system without a force model is bounded by its springs as they are.
-   * With @p unweighted false, `diagonal` and `coupling` (what only the unweighted
-   * bound, squared_frequency_bounds(), reads) are left empty: the weighted bound
-   * (weighted_frequency_bounds()) with given weights needs the rest, at about half the
-   * cost (the diagonal is an eigenvalue per particle).
    */
   GershgorinTerms
-  gershgorin_terms(const ParticleSystem &system,
-                   const double         *positions,
-                   bool                  unweighted = true);
+  gershgorin_terms(const ParticleSystem &system, const double *positions);
 
   /**
    * The squared block Gershgorin row bounds λ_i = diagonal[i] / m_i
@@ -106,6 +100,23 @@ namespace lacerta::physics
   weighted_frequency_bounds(const ParticleSystem      &system,
                             const GershgorinTerms     &terms,
                             const std::vector<double> &weights);
+
+  /**
+   * weighted_frequency_bounds() with @p weights for the particles at @p positions, and
+   * in @p stiffest_spring the stiffest spring at each particle (as
+   * GershgorinTerms::stiffest_spring), without the springs' terms kept in between:
+   * each thread range of the force model works out the terms of its own springs and
+   * adds them to its rows. The same rows to the bit as gershgorin_terms() followed
+   * by weighted_frequency_bounds() (the same stiffest spring unless two tie within
+   * rounding), in one pass over the springs instead of three and no memory per
+   * spring: the periodic check with kept weights
+   * (StabilityBound::bound_with_kept_weights()).
+   */
+  std::vector<double>
+  weighted_frequency_bounds_at(const ParticleSystem      &system,
+                               const double              *positions,
+                               const std::vector<double> &weights,
+                               std::vector<unsigned int> &stiffest_spring);
 
   /**
    * The weight d_i of a row for weighted_frequency_bounds(), from its block Gershgorin
