@@ -3,6 +3,7 @@
 #include <lacerta/base/archive.h>
 #include <lacerta/physics/integrator.h>
 #include <lacerta/physics/particle_system.h>
+#include <lacerta/physics/system_ranges.h>
 
 #include <cmath>
 #include <vector>
@@ -38,40 +39,51 @@ namespace lacerta::physics
       void
       step(ParticleSystem &system, const double t, const double dt) override
       {
-        double           *x = system.position.data();
-        double           *v = system.velocity.data();
-        const std::size_t n = system.position.size();
+        double *x = system.position.data();
+        double *v = system.velocity.data();
 
         // Stage 1 at (x, v).
         system.compute_acceleration(x, v, a_stage.data());
-        for (std::size_t i = 0; i < n; ++i)
-        {
-          dx_sum[i]  = v[i];
-          dv_sum[i]  = a_stage[i];
-          x_stage[i] = x[i] + 0.5 * dt * v[i];
-          v_stage[i] = v[i] + 0.5 * dt * a_stage[i];
-        }
+        for_each_coordinate_range(system,
+                                  [&](const std::size_t begin, const std::size_t end)
+                                  {
+                                    for (std::size_t i = begin; i < end; ++i)
+                                    {
+                                      dx_sum[i]  = v[i];
+                                      dv_sum[i]  = a_stage[i];
+                                      x_stage[i] = x[i] + 0.5 * dt * v[i];
+                                      v_stage[i] = v[i] + 0.5 * dt * a_stage[i];
+                                    }
+                                  });
         // Stages 2 and 3 at the midpoint, with weights 2.
         for (const double to_next : {0.5 * dt, dt})
         {
           system.compute_acceleration(x_stage.data(), v_stage.data(), a_stage.data());
-          for (std::size_t i = 0; i < n; ++i)
-          {
-            const double vs = v_stage[i];
-            dx_sum[i] += 2.0 * vs;
-            dv_sum[i] += 2.0 * a_stage[i];
-            x_stage[i] = x[i] + to_next * vs;
-            v_stage[i] = v[i] + to_next * a_stage[i];
-          }
+          for_each_coordinate_range(system,
+                                    [&](const std::size_t begin, const std::size_t end)
+                                    {
+                                      for (std::size_t i = begin; i < end; ++i)
+                                      {
+                                        const double vs = v_stage[i];
+                                        dx_sum[i] += 2.0 * vs;
+                                        dv_sum[i] += 2.0 * a_stage[i];
+                                        x_stage[i] = x[i] + to_next * vs;
+                                        v_stage[i] = v[i] + to_next * a_stage[i];
+                                      }
+                                    });
         }
         // Stage 4 at the end of the step.
         system.compute_acceleration(x_stage.data(), v_stage.data(), a_stage.data());
         const double sixth = dt / 6.0;
-        for (std::size_t i = 0; i < n; ++i)
-        {
-          x[i] += sixth * (dx_sum[i] + v_stage[i]);
-          v[i] += sixth * (dv_sum[i] + a_stage[i]);
-        }
+        for_each_coordinate_range(system,
+                                  [&](const std::size_t begin, const std::size_t end)
+                                  {
+                                    for (std::size_t i = begin; i < end; ++i)
+                                    {
+                                      x[i] += sixth * (dx_sum[i] + v_stage[i]);
+                                      v[i] += sixth * (dv_sum[i] + a_stage[i]);
+                                    }
+                                  });
         system.enforce_constraints(t + dt, x, v);
       }
 

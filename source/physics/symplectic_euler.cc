@@ -2,6 +2,7 @@
 
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/single_evaluation_integrator.h>
+#include <lacerta/physics/system_ranges.h>
 
 #include <vector>
 
@@ -28,11 +29,15 @@ namespace lacerta::physics
         double *x = system.position.data();
         double *v = system.velocity.data();
         system.compute_acceleration(x, v, acceleration.data());
-        for (std::size_t i = 0; i < acceleration.size(); ++i)
-        {
-          v[i] += dt * acceleration[i];
-          x[i] += dt * v[i];
-        }
+        for_each_coordinate_range(system,
+                                  [&](const std::size_t begin, const std::size_t end)
+                                  {
+                                    for (std::size_t i = begin; i < end; ++i)
+                                    {
+                                      v[i] += dt * acceleration[i];
+                                      x[i] += dt * v[i];
+                                    }
+                                  });
         system.enforce_constraints(t + dt, x, v);
       }
 

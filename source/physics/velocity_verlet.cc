@@ -3,6 +3,7 @@
 #include <lacerta/base/archive.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/single_evaluation_integrator.h>
+#include <lacerta/physics/system_ranges.h>
 
 #include <vector>
 
@@ -38,16 +39,24 @@ namespace lacerta::physics
         double *v = system.velocity.data();
         if (!acceleration_is_current)
           system.compute_acceleration(x, v, acceleration.data());
-        for (std::size_t i = 0; i < acceleration.size(); ++i)
-        {
-          v[i] += 0.5 * dt * acceleration[i];
-          x[i] += dt * v[i];
-        }
+        for_each_coordinate_range(system,
+                                  [&](const std::size_t begin, const std::size_t end)
+                                  {
+                                    for (std::size_t i = begin; i < end; ++i)
+                                    {
+                                      v[i] += 0.5 * dt * acceleration[i];
+                                      x[i] += dt * v[i];
+                                    }
+                                  });
         // Constrained particles must be in place before the new forces are computed.
         system.enforce_constraints(t + dt, x, v);
         system.compute_acceleration(x, v, acceleration.data());
-        for (std::size_t i = 0; i < acceleration.size(); ++i)
-          v[i] += 0.5 * dt * acceleration[i];
+        for_each_coordinate_range(system,
+                                  [&](const std::size_t begin, const std::size_t end)
+                                  {
+                                    for (std::size_t i = begin; i < end; ++i)
+                                      v[i] += 0.5 * dt * acceleration[i];
+                                  });
         system.enforce_constraints(t + dt, x, v);
         acceleration_is_current = true;
       }
