@@ -143,8 +143,7 @@ namespace lacerta::cut
   Point
   Lacerator::position(const unsigned int v) const
   {
-    const double *x = &system.position[3 * v];
-    return {{x[0], x[1], x[2]}};
+    return system.current_position(v);
   }
 
 

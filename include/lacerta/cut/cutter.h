@@ -6,6 +6,7 @@
 #pragma once
 
 #include <lacerta/cut/boundary_face_tree.h>
+#include <lacerta/cut/crossing_decisions.h>
 #include <lacerta/cut/cut_record.h>
 #include <lacerta/cut/cut_rules.h>
 #include <lacerta/cut/split_table.h>
@@ -186,48 +187,11 @@ namespace lacerta::cut
     serialize(Archive &archive);
 
   private:
-    /**
-     * A crossing of a mesh edge by the stroke's swept surface, decided once when the
-     * blade sweeps it: where (the parameter along the edge from its end with the
-     * smaller id, the same at rest as deformed) and which way (the side of the
-     * surface that end lies on, +1 or -1; 0: no crossing).
-     */
-    struct Crossing
-    {
-      double      t    = 0;
-      std::int8_t side = 0;
-      /// Whether the sweep being applied cuts the edge.
-      bool applied = false;
-    };
-    /**
-     * What the crossings decided so far make of one cell: the crossed local edges and
-     * their parameters, and whether they cut it through (its vertices off the cut
-     * fall into two sides, each crossed edge joining the two), with the sides.
-     */
-    struct CellDecision
-    {
-      std::uint8_t               crossed = 0;
-      std::array<double, 6>      t{};
-      std::array<std::int8_t, 4> side{};
-      bool                       complete = false;
-    };
-    /// The key of the edge between vertices @p a < @p b in `crossings`.
-    static std::uint64_t
-    edge_key(const unsigned int a, const unsigned int b)
-    {
-      return (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
-    }
-    /// End @p i (0: the smaller id) of the edge with key @p key.
-    static unsigned int
-    edge_end(const std::uint64_t key, const unsigned int i)
-    {
-      return static_cast<unsigned int>(i == 0 ? key >> 32 : key & 0xFFFFFFFFu);
-    }
-    /// Per-edge scratch: whether the sweep tested the edge (stamp), and its cut point's
-    /// particle while children are made (valid where point_stamp is current).
+    /// Per-edge scratch: its cut point's particle while children are made (valid
+    /// where point_stamp is current).
     struct EdgeScratch
     {
-      unsigned int stamp = 0, point_stamp = 0, point = 0;
+      unsigned int point_stamp = 0, point = 0;
     };
 
     /// One sweep of the blade from @p from to @p to: crossings, cells, split, update.
@@ -245,47 +209,9 @@ namespace lacerta::cut
     /// Current position of particle @p v.
     Point
     position(unsigned int v) const;
-    /// Ends the stroke: vertices on the cut lose that status, undecided crossings go.
-    void
-    end_stroke();
     /// Grows the scratch arrays to the mesh (new entries are invalid).
     void
     prepare_scratch();
-    /// Decides, once, the crossings of the edges of the candidate cells by the swept
-    /// triangles, and the vertices the surface passes through (snapping).
-    void
-    record_crossings(const std::array<std::array<Point, 3>, 2> &swept_triangles);
-    /// How the edge from @p a to @p b (a < b) crosses the swept triangles, whose unit
-    /// normal is @p normal, exactly.
-    /// Also the ends' distances from the surface's plane, in edge lengths, into
-    /// @p distance (for the snapping).
-    Crossing
-    edge_crossing(unsigned int                               a,
-                  unsigned int                               b,
-                  const std::array<std::array<Point, 3>, 2> &swept_triangles,
-                  const Point                               &normal,
-                  std::array<double, 2>                     &distance) const;
-    /// The side vertex @p v was given for the part of the surface with unit normal
-    /// @p normal in this stroke, or 0.
-    std::int8_t
-    kept_side(unsigned int v, const Point &normal) const;
-    /// Vertex @p v lies on side @p side of the part of the surface with unit normal
-    /// @p normal, unless a side was decided for that part already.
-    void
-    keep_side(unsigned int v, std::int8_t side, const Point &normal);
-    /// The size of the cells around the edge from @p a to @p b (their longest edge at
-    /// rest): the snapping distance is a fraction of it.
-    double
-    cell_size_around(unsigned int a, unsigned int b) const;
-    /// Whether vertex @p v may be put on the cut (snapping).
-    bool
-    may_snap(unsigned int v) const;
-    /// Vertex @p v lies on the cut from now on (decided in this sweep).
-    void
-    put_on_surface(unsigned int v);
-    /// What the decided crossings make of cell @p t.
-    CellDecision
-    decide_cell(unsigned int t) const;
     /// The cells the sweep splits (`affected`): those the crossings cut through, the
     /// cells around the crossings they apply, and the stars of the vertices on the cut
     /// whose copies are decided again.
@@ -294,15 +220,6 @@ namespace lacerta::cut
     /// One TetCut per cell of `affected` that changes, into `removed` and `cuts`.
     void
     make_cuts();
-    /// The TetCut that leaves cell @p t whole (the table flags its faces on the cut).
-    TetCut
-    whole_cell(unsigned int t) const;
-    /// Removes the crossings the sweep applies (their edges are split).
-    void
-    forget_applied_crossings();
-    /// Removes the crossing at @p it; returns the next one.
-    std::unordered_map<std::uint64_t, Crossing>::iterator
-    forget_crossing(std::unordered_map<std::uint64_t, Crossing>::iterator it);
     /// Replaces `removed` by the children of `results`, copies the vertices on the
     /// cut, updates masses, springs and the active set: the stages below.
     void
@@ -327,9 +244,6 @@ namespace lacerta::cut
     void
     update_active_cells(const Blade &end);
 
-    /// Vertex @p v lies on the cut of the current stroke.
-    void
-    mark_on_surface(unsigned int v);
 
     /// Adds the time since the last lap to @p phase (per-phase statistics).
     void
@@ -342,77 +256,18 @@ namespace lacerta::cut
     double                 &integral_of_density;
     Parameters              parameters;
     Blade                   current;
+    /// The stroke's decisions: crossings, sides, vertices on the cut.
+    CrossingDecisions decisions;
     /// Typical edge length at rest (median), for the sub-division when nothing is active.
-    double                    typical_edge = 0;
-    BoundaryFaceTree          tree;
-    std::vector<unsigned int> active, next_active, candidates, queue;
-    std::vector<unsigned int> tet_stamp, edge_stamp;
-    unsigned int              stamp = 0;
-    /// Vertices on the cut surface of the current stroke.
-    std::vector<std::uint8_t>           on_surface;
-    std::vector<unsigned int>           on_surface_list;
+    double                              typical_edge = 0;
+    BoundaryFaceTree                    tree;
+    std::vector<unsigned int>           active, next_active, candidates, queue;
+    std::vector<unsigned int>           tet_stamp, edge_stamp;
+    unsigned int                        stamp = 0;
     std::vector<BoundaryFaceTree::Face> hits;
-    /**
-     * The side of the swept surface a vertex next to it was found on, once, in the
-     * stroke `stroke`, for the part of the surface with unit normal `normal`.
-     */
-    struct SideRecord
-    {
-      std::int8_t  side   = 0;
-      unsigned int stroke = 0;
-      Point        normal{};
-    };
-    std::vector<SideRecord> side_records;
-    /// A triangle the current sweep swept (deformed).
-    std::array<Point, 3> sweep_triangle{};
-    /**
-     * The part of the swept surface the current sweep belongs to: a new part starts
-     * where the blade turns by more than 45 degrees from its last sweep (a corner of
-     * the path). `normal` is the unit normal of its last sweep (zero between strokes),
-     * `triangles` the triangles of its sweeps before the current one (deformed, at most
-     * `kept_part_sweeps` sweeps).
-     */
-    struct SurfacePart
-    {
-      Point                             normal{};
-      std::vector<std::array<Point, 3>> triangles;
-    };
-    SurfacePart part;
-    /// How many earlier sweeps of the current part `part` keeps.
-    static constexpr unsigned int kept_part_sweeps = 8;
-    /// Starts a new part for a sweep with unit normal @p normal if the blade turned by
-    /// more than 45 degrees since its last sweep (or the stroke begins).
-    void
-    follow_part(const Point &normal);
-    /// Keeps the current sweep's @p swept_triangles in `part`.
-    void
-    keep_part_sweep(const std::array<std::array<Point, 3>, 2> &swept_triangles);
-    /**
-     * Whether the current part of the swept surface reaches within @p distance of
-     * vertex @p v (deformed): the vertex lies ahead of the start of the current sweep
-     * @p swept_triangles, or within @p distance of its triangles or of the part's
-     * earlier sweeps. A part that starts at a corner does not reach behind the corner.
-     */
-    bool
-    part_reaches(unsigned int                               v,
-                 double                                     distance,
-                 const std::array<std::array<Point, 3>, 2> &swept_triangles) const;
     /// The vertices of the cells the blade was in at the end of the last motion, with
     /// their positions then.
     std::vector<std::pair<unsigned int, Point>> blade_cell_positions;
-    /// The current stroke (from entering the tissue to leaving it), from 1.
-    unsigned int stroke = 1;
-    /// The crossings decided in the current stroke and not applied yet, by edge key.
-    std::unordered_map<std::uint64_t, Crossing> crossings;
-    /// Per vertex, the number of its edges in `crossings`.
-    std::vector<unsigned int> crossings_at;
-    /// The crossings and the vertices on the cut the current sweep decided.
-    std::vector<std::uint64_t> new_crossings;
-    std::vector<unsigned int>  new_on_surface;
-    /// The crossings the current sweep applies.
-    std::vector<std::uint64_t> applied_crossings;
-    /// Vertices of an adopted crack (adopt_crack()) whose copies the next sweep decides.
-    std::vector<unsigned int> adopted;
     // Scratch, kept between sweeps so that no sweep allocates or clears O(mesh).
     std::vector<EdgeScratch> edge_scratch;
     /// Per cell: in `affected` (stamp), and in the star of a vertex whose copies are
@@ -421,7 +276,7 @@ namespace lacerta::cut
     /// Per vertex: came onto the cut in this sweep (stamp).
     std::vector<unsigned int> fresh_mark;
     std::vector<std::uint8_t> in_star;
-    unsigned int              analysis_stamp = 0, affected_stamp = 0, merge_stamp = 0;
+    unsigned int              affected_stamp = 0, merge_stamp = 0;
     std::vector<unsigned int> affected, around, removed, added_ids, star_group, copy_ids;
     std::vector<TetCut>       cuts;
     std::vector<SplitResult>  results;

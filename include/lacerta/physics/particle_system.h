@@ -111,6 +111,13 @@ namespace lacerta::physics
       return static_cast<unsigned int>(mass.size());
     }
 
+    /// The current position of particle @p i.
+    std::array<double, 3>
+    current_position(const unsigned int i) const
+    {
+      return {{position[3 * i], position[3 * i + 1], position[3 * i + 2]}};
+    }
+
     /**
      * Makes room for @p n particles, so that add_particle() up to that many copies
      * no array (the cutter adds particles in its local updates).
