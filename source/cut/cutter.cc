@@ -100,6 +100,7 @@ namespace lacerta::cut
       , parameters(parameters_in)
       , current(initial)
       , decisions(mesh_in, system_in, parameters_in.snap_fraction)
+      , search(mesh_in, system_in)
   {
     // The split table is built on first use (about 10 ms): now, so that the first cut
     // of a run does not wait for it.
@@ -115,9 +116,8 @@ namespace lacerta::cut
     decisions.reserve(room(mesh.n_vertices()));
     separate_mark.reserve(room(mesh.n_vertices()));
     edge_scratch.reserve(room(mesh.n_edges()));
-    edge_stamp.reserve(room(mesh.n_edges()));
     tet_mark.reserve(room(mesh.n_tets()));
-    tet_stamp.reserve(room(mesh.n_tets()));
+    search.reserve(room(mesh.n_tets()), room(mesh.n_edges()));
     in_star.reserve(room(mesh.n_tets()));
     std::vector<double> lengths;
     for (const auto &e : mesh.get_edges())
@@ -126,9 +126,6 @@ namespace lacerta::cut
                      lengths.begin() + lengths.size() / 2,
                      lengths.end());
     typical_edge = lengths[lengths.size() / 2];
-    tree.build(mesh, system.position.data());
-    tet_stamp.assign(mesh.n_tets(), 0);
-    edge_stamp.assign(mesh.n_edges(), 0);
     prepare_scratch();
   }
 
@@ -137,125 +134,6 @@ namespace lacerta::cut
   Cutter::position(const unsigned int v) const
   {
     return system.current_position(v);
-  }
-
-
-  bool
-  Cutter::tet_meets(const unsigned int                         t,
-                    const std::array<std::array<Point, 3>, 2> &swept) const
-  {
-    const mesh::Tet     &tet = mesh.tet(t);
-    std::array<Point, 4> p;
-    for (unsigned int i = 0; i < 4; ++i)
-      p[i] = position(tet[i]);
-    double s;
-    for (const auto &tri : swept)
-    {
-      for (const auto &e : tet_edge_vertices)
-        if (segment_hits_triangle(p[e[0]], p[e[1]], tri[0], tri[1], tri[2], s))
-          return true;
-      for (unsigned int f = 0; f < 4; ++f)
-      {
-        const auto &fv = mesh::TetMesh::face_vertices[f];
-        for (unsigned int k = 0; k < 3; ++k)
-          if (segment_hits_triangle(
-                tri[k], tri[(k + 1) % 3], p[fv[0]], p[fv[1]], p[fv[2]], s))
-            return true;
-      }
-      const auto l = barycentric(p[0], p[1], p[2], p[3], tri[0]);
-      if (std::min({l[0], l[1], l[2], l[3]}) >= 0)
-        return true;
-    }
-    return false;
-  }
-
-
-  bool
-  Cutter::blade_in_tet(const unsigned int t, const Blade &b) const
-  {
-    const mesh::Tet     &tet = mesh.tet(t);
-    std::array<Point, 4> p;
-    for (unsigned int i = 0; i < 4; ++i)
-      p[i] = position(tet[i]);
-    double s;
-    for (unsigned int f = 0; f < 4; ++f)
-    {
-      const auto &fv = mesh::TetMesh::face_vertices[f];
-      if (segment_hits_triangle(b.tail, b.head, p[fv[0]], p[fv[1]], p[fv[2]], s))
-        return true;
-    }
-    const auto l = barycentric(p[0], p[1], p[2], p[3], b.tail);
-    return std::min({l[0], l[1], l[2], l[3]}) >= 0;
-  }
-
-
-  void
-  Cutter::find_tets_to_cut(const std::array<std::array<Point, 3>, 2> &swept,
-                           const Blade                               &end)
-  {
-    tet_stamp.resize(mesh.n_tets(), 0);
-    edge_stamp.resize(mesh.n_edges(), 0);
-    ++stamp;
-    candidates.clear();
-    next_active.clear();
-    queue.clear();
-    const auto push = [&](const unsigned int t)
-    {
-      if (t < mesh.n_tets() && tet_stamp[t] != stamp)
-      {
-        tet_stamp[t] = stamp;
-        queue.push_back(t);
-      }
-    };
-    for (const unsigned int t : active)
-      push(t);
-    // First contact: the swept triangles against the boundary faces, through the tree.
-    hits.clear();
-    tree.query(mesh, system.position.data(), swept, hits);
-    for (const auto &f : hits)
-    {
-      const auto tri = BoundaryFaceTree::triangle(f, system.position.data());
-      if (triangles_intersect(tri, swept[0]) || triangles_intersect(tri, swept[1]))
-        push(f.tet);
-    }
-    // Propagation: through the cells around every intersected edge (each edge tested
-    // once per sweep), no global search.
-    for (std::size_t q = 0; q < queue.size(); ++q)
-    {
-      const unsigned int t = queue[q];
-      if (!tet_meets(t, swept))
-        continue;
-      candidates.push_back(t);
-      bool crossed_edge = false;
-      for (unsigned int e = 0; e < 6; ++e)
-      {
-        const unsigned int id = mesh.tet_edges(t)[e];
-        if (edge_stamp[id] == stamp)
-          continue;
-        edge_stamp[id]       = stamp;
-        const unsigned int a = mesh.tet(t)[tet_edge_vertices[e][0]];
-        const unsigned int b = mesh.tet(t)[tet_edge_vertices[e][1]];
-        double             s;
-        if (segment_hits_triangle(
-              position(a), position(b), swept[0][0], swept[0][1], swept[0][2], s)
-            || segment_hits_triangle(
-              position(a), position(b), swept[1][0], swept[1][1], swept[1][2], s))
-        {
-          crossed_edge = true;
-          around.clear();
-          mesh.tets_around_edge(a, b, around);
-          for (const unsigned int n : around)
-            push(n);
-        }
-      }
-      // The surface can enter a cell through a face without crossing its edges (a
-      // small sweep inside one cell): look across the faces then.
-      if (!crossed_edge)
-        for (unsigned int f = 0; f < 4; ++f)
-          push(mesh.neighbor(t, f));
-      if (blade_in_tet(t, end))
-        next_active.push_back(t);
-    }
   }
 
 
@@ -268,17 +146,17 @@ namespace lacerta::cut
     if (!(advance > 0))
       return statistics;
     const auto t_refit = Clock::now();
-    tree.refit(mesh, system.position.data());
+    search.refit();
     statistics.search_seconds +=
       std::chrono::duration<double>(Clock::now() - t_refit).count();
     // The local element size: the median edge of the active cells (deformed), or of
     // the mesh when the blade is outside. Not the shortest: cells a cut made small
     // must not multiply the sweeps, each of which re-splits the cells at the front.
     double h = typical_edge;
-    if (!active.empty())
+    if (!search.active().empty())
     {
       std::vector<double> lengths;
-      for (const unsigned int t : active)
+      for (const unsigned int t : search.active())
         for (const auto &e : tet_edge_vertices)
           lengths.push_back(
             norm(sub(position(mesh.tet(t)[e[1]]), position(mesh.tet(t)[e[0]]))));
@@ -330,10 +208,10 @@ namespace lacerta::cut
     }
     current = next;
     // The blade has left the tissue (it is in no cell): the stroke is over.
-    if (active.empty())
+    if (search.active().empty())
       decisions.end_stroke();
     blade_cell_positions.clear();
-    for (const unsigned int t : active)
+    for (const unsigned int t : search.active())
       for (const unsigned int v : mesh.tet(t))
         blade_cell_positions.push_back({v, position(v)});
     if (statistics.changed)
@@ -354,11 +232,10 @@ namespace lacerta::cut
     const std::array<std::array<Point, 3>, 2> swept_triangles = {
       {{{from.tail, from.head, to.tail}}, {{to.tail, from.head, to.head}}}};
     const auto t_search = Clock::now();
-    find_tets_to_cut(swept_triangles, to);
+    search.find(swept_triangles, to);
     statistics.search_seconds +=
       std::chrono::duration<double>(Clock::now() - t_search).count();
-    active.swap(next_active);
-    if (candidates.empty())
+    if (search.cells().empty())
     {
       // Out of the tissue: the stroke is over.
       decisions.end_stroke();
@@ -367,7 +244,7 @@ namespace lacerta::cut
     const auto t_start = Clock::now();
     lap_start          = t_start;
     prepare_scratch();
-    decisions.record_sweep(candidates, swept_triangles);
+    decisions.record_sweep(search.cells(), swept_triangles);
     select_cells();
     make_cuts();
     lap(statistics.analysis_seconds);
@@ -714,13 +591,8 @@ namespace lacerta::cut
 
 
   void
-  Cutter::index_new_boundary_faces()
+  Cutter::clamp_rounded_masses()
   {
-    prepare_scratch();
-    for (const unsigned int t : added_ids)
-      for (unsigned int f = 0; f < 4; ++f)
-        if (mesh.neighbor(t, f) == mesh::invalid_index)
-          tree.add_face(mesh, t, f);
     // A vertex that lost all its cells cannot happen (copies take over whole stars),
     // but a mass that rounding left a hair below zero would be nonsense: clamp. A mass
     // further below zero is a particle that gave mass to its neighbours
@@ -730,38 +602,6 @@ namespace lacerta::cut
     for (const unsigned int v : topology.touched_particles())
       if (system.mass[v] < 0 && system.mass[v] > -rounding)
         system.mass[v] = 0;
-  }
-
-
-  void
-  Cutter::update_active_cells(const Blade &end)
-  {
-    // The active cells: the new ones the blade is in.
-    std::sort(removed.begin(), removed.end());
-    active.erase(std::remove_if(active.begin(),
-                                active.end(),
-                                [&](unsigned int t) {
-                                  return std::binary_search(removed.begin(),
-                                                            removed.end(),
-                                                            t);
-                                }),
-                 active.end());
-    // A new cell whose box is farther from the blade's than a tenth of its own size
-    // does not contain the blade, and the exact test's rounding moves its answer by
-    // far less than that (blade_in_tet() ignores faces within 1e-14 rad of the
-    // blade's direction): only the cells near the blade are tested.
-    Box blade_box;
-    blade_box.extend(end.tail);
-    blade_box.extend(end.head);
-    for (const unsigned int t : added_ids)
-    {
-      Box cell;
-      for (const unsigned int v : mesh.tet(t))
-        cell.extend(position(v));
-      cell.inflate(0.1 * cell.size());
-      if (cell.overlaps(blade_box) && blade_in_tet(t, end))
-        active.push_back(t);
-    }
   }
 
 
@@ -793,9 +633,10 @@ namespace lacerta::cut
     added_ids = topology.replace(removed, children, face_ids);
     lap(statistics.mesh_seconds);
 
-    index_new_boundary_faces();
+    prepare_scratch();
+    clamp_rounded_masses();
     integral_of_density += topology.mass_delta() - mass_before;
-    update_active_cells(end);
+    search.follow_replacement(removed, added_ids, end);
     statistics.changed = true;
     lap(statistics.physics_seconds);
   }
@@ -824,7 +665,8 @@ namespace lacerta::cut
   {
     // What a blade motion leaves for the next one; the rest is scratch of a motion.
     archive.section("cutter");
-    archive(current, typical_edge, tree, active, blade_cell_positions);
+    archive(current, typical_edge, blade_cell_positions);
+    search.serialize(archive);
     decisions.serialize(archive);
   }
 } // namespace lacerta::cut

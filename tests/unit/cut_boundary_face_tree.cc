@@ -21,16 +21,7 @@ namespace
   /// A face as (tet, face), for comparing sets of answers.
   using FaceKey = std::pair<unsigned int, unsigned int>;
 
-  mesh::TetMesh
-  box_tet_mesh(const unsigned int n, std::mt19937 &rng)
-  {
-    const auto                box = cut::test_support::box_mesh(n, rng);
-    std::vector<mesh::Point3> x(box.points.begin(), box.points.end());
-    std::vector<mesh::Tet>    t;
-    for (const auto &c : box.tets)
-      t.push_back({{c[0], c[1], c[2], c[3]}});
-    return mesh::TetMesh(x, t, "box");
-  }
+  using cut::test_support::box_tet_mesh;
 
   /// The faces a query of @p box must give: every boundary face whose box at @p x
   /// overlaps it.

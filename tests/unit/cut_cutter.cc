@@ -49,12 +49,7 @@ namespace
                const Blade       &start,
                const double       stretch = 1.0)
     {
-      const auto                box = cut::test_support::box_mesh(n, rng);
-      std::vector<mesh::Point3> x(box.points.begin(), box.points.end());
-      std::vector<mesh::Tet>    t;
-      for (const auto &c : box.tets)
-        t.push_back({{c[0], c[1], c[2], c[3]}});
-      mesh     = mesh::TetMesh(x, t, "box");
+      mesh     = cut::test_support::box_tet_mesh(n, rng);
       system   = test_support::make_system(mesh,
                                          density.value(dealii::Point<3>()),
                                          youngs.value(dealii::Point<3>()));

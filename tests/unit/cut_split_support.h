@@ -12,6 +12,7 @@
 #include <lacerta/cut/cutter.h>
 #include <lacerta/cut/geometry.h>
 #include <lacerta/cut/split_table.h>
+#include <lacerta/mesh/tet_mesh.h>
 
 #include <algorithm>
 #include <array>
@@ -650,6 +651,18 @@ namespace lacerta::cut::test_support
             mesh.tets.push_back(t);
           }
     return mesh;
+  }
+
+  /// box_mesh() as a TetMesh.
+  inline mesh::TetMesh
+  box_tet_mesh(const unsigned n, std::mt19937 &rng)
+  {
+    const auto                box = box_mesh(n, rng);
+    std::vector<mesh::Point3> x(box.points.begin(), box.points.end());
+    std::vector<mesh::Tet>    t;
+    for (const auto &c : box.tets)
+      t.push_back({{c[0], c[1], c[2], c[3]}});
+    return mesh::TetMesh(x, t, "box");
   }
 
   /**

@@ -5,11 +5,11 @@
  */
 #pragma once
 
-#include <lacerta/cut/boundary_face_tree.h>
 #include <lacerta/cut/crossing_decisions.h>
 #include <lacerta/cut/cut_record.h>
 #include <lacerta/cut/cut_rules.h>
 #include <lacerta/cut/split_table.h>
+#include <lacerta/cut/sweep_search.h>
 #include <lacerta/cut/tool.h>
 #include <lacerta/mesh/tet_mesh.h>
 #include <lacerta/physics/topology_update.h>
@@ -179,7 +179,7 @@ namespace lacerta::cut
     const std::vector<unsigned int> &
     active_tets() const
     {
-      return active;
+      return search.active();
     }
 
     /// Writes or reads the state for a checkpoint (see lacerta::Archive).
@@ -197,15 +197,6 @@ namespace lacerta::cut
     /// One sweep of the blade from @p from to @p to: crossings, cells, split, update.
     void
     sweep(const Blade &from, const Blade &to, CutStepStatistics &statistics);
-    /// FindTetraToCut: fills `candidates` (C) and `next_active` (A_t+1).
-    void
-    find_tets_to_cut(const std::array<std::array<Point, 3>, 2> &swept, const Blade &end);
-    /// Whether tetrahedron @p t meets the swept triangles (deformed configuration).
-    bool
-    tet_meets(unsigned int t, const std::array<std::array<Point, 3>, 2> &swept) const;
-    /// Whether the segment (blade) meets tetrahedron @p t.
-    bool
-    blade_in_tet(unsigned int t, const Blade &b) const;
     /// Current position of particle @p v.
     Point
     position(unsigned int v) const;
@@ -236,13 +227,9 @@ namespace lacerta::cut
     /// faces not on the cut (separate_star()).
     void
     separate_points_on_cut(CutStepStatistics &statistics, CutRecord *record);
-    /// After the mesh update: the new cells' boundary faces indexed, masses that
-    /// rounding left a hair below zero clamped.
+    /// After the mesh update: masses that rounding left a hair below zero clamped.
     void
-    index_new_boundary_faces();
-    /// The active cells: the new ones blade @p end is in.
-    void
-    update_active_cells(const Blade &end);
+    clamp_rounded_masses();
 
 
     /// Adds the time since the last lap to @p phase (per-phase statistics).
@@ -259,12 +246,9 @@ namespace lacerta::cut
     /// The stroke's decisions: crossings, sides, vertices on the cut.
     CrossingDecisions decisions;
     /// Typical edge length at rest (median), for the sub-division when nothing is active.
-    double                              typical_edge = 0;
-    BoundaryFaceTree                    tree;
-    std::vector<unsigned int>           active, next_active, candidates, queue;
-    std::vector<unsigned int>           tet_stamp, edge_stamp;
-    unsigned int                        stamp = 0;
-    std::vector<BoundaryFaceTree::Face> hits;
+    double typical_edge = 0;
+    /// FindTetraToCut: the cells a sweep meets and the cells the blade is in.
+    SweepSearch search;
     /// The vertices of the cells the blade was in at the end of the last motion, with
     /// their positions then.
     std::vector<std::pair<unsigned int, Point>> blade_cell_positions;
