@@ -5,9 +5,11 @@
  */
 #pragma once
 
+#include <lacerta/cut/child_builder.h>
 #include <lacerta/cut/crossing_decisions.h>
 #include <lacerta/cut/cut_record.h>
 #include <lacerta/cut/cut_rules.h>
+#include <lacerta/cut/cut_step_statistics.h>
 #include <lacerta/cut/split_table.h>
 #include <lacerta/cut/sweep_search.h>
 #include <lacerta/cut/tool.h>
@@ -40,47 +42,6 @@ namespace lacerta
 }
 namespace lacerta::cut
 {
-  /// Boundary id of the faces a cut opens (the two sheets of the crack).
-  inline constexpr unsigned int cut_boundary_id = 99;
-
-  /**
-   * What one blade motion did: the columns of the paper's Table 1 and a little more.
-   */
-  struct CutStepStatistics
-  {
-    /// Tetrahedra replaced (CuT) and tetrahedra created (CrT).
-    unsigned int cut_tets = 0, created_tets = 0;
-    /// Particles created (cut points, copies of points on the cut).
-    unsigned int new_particles = 0;
-    /// Sub-steps of the swept surface.
-    unsigned int sweeps = 0;
-    /// Wall time of the local mesh and physics update, and of the force model's
-    /// update for the springs the motion changed (ForceModel::springs_changed()), in
-    /// seconds.
-    double update_seconds = 0, reinit_seconds = 0;
-    /**
-     * Where the time went, in seconds. `search_seconds` (not part of update_seconds):
-     * the boundary face tree's refit, the first contact and the propagation
-     * (FindTetraToCut). The parts of update_seconds: `analysis_seconds` (the crossings
-     * decided, the cells cut through and the closure around them, one TetCut per cell),
-     * `split_seconds` (the split table),
-     * `children_seconds` (the children's nodes, new particles, copies of the points
-     * on the cut), `mesh_seconds` (TetMesh::replace_tets()) and `physics_seconds`
-     * (masses, springs, the tree's new faces, the active set).
-     */
-    double search_seconds = 0, analysis_seconds = 0, split_seconds = 0,
-           children_seconds = 0, mesh_seconds = 0, physics_seconds = 0;
-    /// Whether the mesh changed (then the integrator must be re-initialised).
-    bool changed = false;
-    /**
-     * Particles duplicated along the cut surface, as (original, copy), in the order
-     * made (a copy can be copied again later). A copy starts with its original's
-     * state and `free` flag; whoever holds particle lists (the scene's constraints)
-     * extends them so that a fixed particle stays fixed and a handle keeps pulling.
-     */
-    std::vector<std::array<unsigned int, 2>> copied_particles;
-  };
-
   /**
    * Cuts a tetrahedral mesh and its particle system with a moving blade.
    *
@@ -187,13 +148,6 @@ namespace lacerta::cut
     serialize(Archive &archive);
 
   private:
-    /// Per-edge scratch: its cut point's particle while children are made (valid
-    /// where point_stamp is current).
-    struct EdgeScratch
-    {
-      unsigned int point_stamp = 0, point = 0;
-    };
-
     /// One sweep of the blade from @p from to @p to: crossings, cells, split, update.
     void
     sweep(const Blade &from, const Blade &to, CutStepStatistics &statistics);
@@ -216,17 +170,6 @@ namespace lacerta::cut
     void
     apply(const Blade &end, CutStepStatistics &statistics);
 
-    /// A particle at rest position @p rest in cell @p parent, its state interpolated.
-    unsigned int
-    new_particle(const Point &rest, unsigned int parent, CutStepStatistics &statistics);
-    /// The children of `results` with their points (one particle per cut edge) and
-    /// boundary ids, into `children`, `child_cut_faces` and `face_ids`.
-    void
-    make_children(CutStepStatistics &statistics, CutRecord *record);
-    /// Copies every point on the cut once per group of its children connected through
-    /// faces not on the cut (separate_star()).
-    void
-    separate_points_on_cut(CutStepStatistics &statistics, CutRecord *record);
     /// After the mesh update: masses that rounding left a hair below zero clamped.
     void
     clamp_rounded_masses();
@@ -252,28 +195,25 @@ namespace lacerta::cut
     /// The vertices of the cells the blade was in at the end of the last motion, with
     /// their positions then.
     std::vector<std::pair<unsigned int, Point>> blade_cell_positions;
-    // Scratch, kept between sweeps so that no sweep allocates or clears O(mesh).
-    std::vector<EdgeScratch> edge_scratch;
+    /// The children of the cells a sweep splits, and the copies of points on the cut.
+    ChildBuilder children;
+    // Scratch of the cell selection, kept between sweeps so that no sweep allocates or
+    // clears O(mesh).
     /// Per cell: in `affected` (stamp), and in the star of a vertex whose copies are
     /// decided again. Per vertex: its copies are decided in this sweep (stamp).
     std::vector<unsigned int> tet_mark, separate_mark;
     /// Per vertex: came onto the cut in this sweep (stamp).
     std::vector<unsigned int> fresh_mark;
     std::vector<std::uint8_t> in_star;
-    unsigned int              affected_stamp = 0, merge_stamp = 0;
-    std::vector<unsigned int> affected, around, removed, added_ids, star_group, copy_ids;
+    unsigned int              affected_stamp = 0;
+    /// The cells the sweep changes, the vertices whose copies it decides, the cells it
+    /// removes and those that replace them.
+    std::vector<unsigned int> affected, separated, around, removed, added_ids;
     std::vector<TetCut>       cuts;
     std::vector<SplitResult>  results;
-    std::vector<mesh::Tet>    children;
-    std::vector<std::uint8_t> child_cut_faces;
-    std::vector<std::array<unsigned int, 4>> face_ids;
-    std::vector<std::array<unsigned int, 2>> incidences;
-    std::vector<StarCell>                    star;
     /// The end of the last lap().
     std::chrono::steady_clock::time_point lap_start;
     /// Where sweeps are recorded (set_recorder()), or nullptr.
     std::vector<CutRecord> *recorder = nullptr;
-    /// Per child of the sweep being applied, when recording: (split, child of the split).
-    std::vector<std::array<unsigned int, 2>> child_origin;
   };
 } // namespace lacerta::cut
