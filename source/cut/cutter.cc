@@ -73,6 +73,7 @@ namespace lacerta::cut
       , decisions(mesh_in, system_in, parameters_in.snap_fraction)
       , search(mesh_in, system_in)
       , children(mesh_in, system_in)
+      , selection(mesh_in)
   {
     // The split table is built on first use (about 10 ms): now, so that the first cut
     // of a run does not wait for it.
@@ -87,9 +88,8 @@ namespace lacerta::cut
     system.springs.reserve(room(system.springs.size()));
     decisions.reserve(room(mesh.n_vertices()));
     children.reserve(room(mesh.n_vertices()), room(mesh.n_edges()));
-    tet_mark.reserve(room(mesh.n_tets()));
     search.reserve(room(mesh.n_tets()), room(mesh.n_edges()));
-    in_star.reserve(room(mesh.n_tets()));
+    selection.reserve(room(mesh.n_tets()));
     std::vector<double> lengths;
     for (const auto &e : mesh.get_edges())
       lengths.push_back(norm(sub(mesh.vertex(e[1]), mesh.vertex(e[0]))));
@@ -216,11 +216,11 @@ namespace lacerta::cut
     lap_start          = t_start;
     prepare_scratch();
     decisions.record_sweep(search.cells(), swept_triangles);
-    select_cells();
-    make_cuts();
+    selection.select(decisions);
     lap(statistics.analysis_seconds);
-    if (!removed.empty())
+    if (!selection.removed().empty())
     {
+      const std::vector<TetCut> &cuts = selection.cuts();
       results.resize(cuts.size());
       for (std::size_t k = 0; k < cuts.size(); ++k)
         split_tetrahedron(cuts[k], results[k], parameters.snap_fraction);
@@ -237,128 +237,6 @@ namespace lacerta::cut
   Cutter::prepare_scratch()
   {
     decisions.prepare();
-    tet_mark.resize(mesh.n_tets(), 0);
-    in_star.resize(mesh.n_tets(), 0);
-    if (separate_mark.size() < mesh.n_vertices())
-      separate_mark.resize(mesh.n_vertices(), 0);
-    fresh_mark.resize(std::max<std::size_t>(fresh_mark.size(), mesh.n_vertices()), 0);
-  }
-
-
-  void
-  Cutter::select_cells()
-  {
-    ++affected_stamp;
-    affected.clear();
-    separated.clear();
-    const auto consider = [&](const unsigned int t)
-    {
-      if (tet_mark[t] != affected_stamp)
-      {
-        tet_mark[t] = affected_stamp;
-        in_star[t]  = 0;
-        affected.push_back(t);
-      }
-    };
-    const auto consider_edge = [&](const std::uint64_t key)
-    {
-      around.clear();
-      mesh.tets_around_edge(CrossingDecisions::edge_end(key, 0),
-                            CrossingDecisions::edge_end(key, 1),
-                            around);
-      for (const unsigned int n : around)
-        consider(n);
-    };
-    // The cells whose copies of @p v are decided again: its whole star.
-    const auto separate = [&](const unsigned int v)
-    {
-      if (separate_mark[v] == affected_stamp)
-        return;
-      separate_mark[v] = affected_stamp;
-      separated.push_back(v);
-      for (const unsigned int n : mesh.tets_of_vertex(v))
-      {
-        consider(n);
-        in_star[n] = 1;
-      }
-    };
-    for (const std::uint64_t key : decisions.new_crossings())
-      consider_edge(key);
-    for (const unsigned int v : decisions.new_on_cut())
-      fresh_mark[v] = affected_stamp;
-    for (const unsigned int v : decisions.new_on_cut())
-      separate(v);
-    // The closure: a cell cut through applies its crossings, and every cell around
-    // an applied crossing is split with it (conforming: it is refined through the
-    // cut point if the surface does not cross it through yet); the vertices on the
-    // cut in a cell cut through get their copies decided over their whole stars.
-    for (std::size_t q = 0; q < affected.size(); ++q)
-    {
-      const unsigned int t   = affected[q];
-      const mesh::Tet   &tet = mesh.tet(t);
-      // A face whose last vertex came onto the cut in this sweep lies in the cut from
-      // now on: the copies of all three of its vertices are decided again.
-      for (const auto &fv : mesh::TetMesh::face_vertices)
-        if (decisions.on_cut(tet[fv[0]]) && decisions.on_cut(tet[fv[1]])
-            && decisions.on_cut(tet[fv[2]])
-            && (fresh_mark[tet[fv[0]]] == affected_stamp
-                || fresh_mark[tet[fv[1]]] == affected_stamp
-                || fresh_mark[tet[fv[2]]] == affected_stamp))
-          for (const unsigned int k : fv)
-            separate(tet[k]);
-      const CrossingDecisions::CellDecision d = decisions.decide_cell(t);
-      if (!d.complete)
-        continue;
-      for (unsigned int e = 0; e < 6; ++e)
-        if ((d.crossed >> e) & 1u)
-        {
-          const std::uint64_t key =
-            CrossingDecisions::edge_key(tet[tet_edge_vertices[e][0]],
-                                        tet[tet_edge_vertices[e][1]]);
-          if (decisions.apply_crossing(key))
-            consider_edge(key);
-        }
-      for (const unsigned int v : tet)
-        if (decisions.on_cut(v))
-          separate(v);
-    }
-  }
-
-
-  void
-  Cutter::make_cuts()
-  {
-    removed.clear();
-    cuts.clear();
-    for (const unsigned int t : affected)
-    {
-      const CrossingDecisions::CellDecision d   = decisions.decide_cell(t);
-      const mesh::Tet                      &tet = mesh.tet(t);
-      TetCut                                c   = decisions.whole_cell(t);
-      if (d.complete)
-        for (unsigned int i = 0; i < 4; ++i)
-          c.vertex_side[i] = d.side[i];
-      for (unsigned int e = 0; e < 6; ++e)
-        if ((d.crossed >> e) & 1u)
-        {
-          const bool applied =
-            d.complete
-            || decisions.is_applied(
-              CrossingDecisions::edge_key(tet[tet_edge_vertices[e][0]],
-                                          tet[tet_edge_vertices[e][1]]));
-          if (applied)
-          {
-            c.cut_edges |= std::uint8_t(1u << e);
-            c.edge_parameter[e] = d.t[e];
-          }
-        }
-      // A cell that is neither cut nor refined nor in the star of a vertex whose
-      // copies are decided stays as it is.
-      if (c.cut_edges == 0 && !in_star[t])
-        continue;
-      removed.push_back(t);
-      cuts.push_back(c);
-    }
   }
 
 
@@ -385,7 +263,8 @@ namespace lacerta::cut
     // dies is retired with it). Every spring gets these terms first and those of the
     // new cells after, in the order of the cells.
     topology.clear_touched();
-    const double mass_before = topology.mass_delta();
+    const double                     mass_before = topology.mass_delta();
+    const std::vector<unsigned int> &removed     = selection.removed();
     topology.take_out(removed);
     lap(statistics.physics_seconds);
 
@@ -393,10 +272,16 @@ namespace lacerta::cut
     CutRecord *record = recorder ? &recorder->emplace_back() : nullptr;
     if (record)
     {
-      record->cuts          = cuts;
+      record->cuts          = selection.cuts();
       record->snap_fraction = parameters.snap_fraction;
     }
-    children.build(removed, cuts, results, separated, decisions, statistics, record);
+    children.build(removed,
+                   selection.cuts(),
+                   results,
+                   selection.separated(),
+                   decisions,
+                   statistics,
+                   record);
     lap(statistics.children_seconds);
 
     // The mesh, locally.

@@ -5,6 +5,7 @@
  */
 #pragma once
 
+#include <lacerta/cut/cell_selection.h>
 #include <lacerta/cut/child_builder.h>
 #include <lacerta/cut/crossing_decisions.h>
 #include <lacerta/cut/cut_record.h>
@@ -157,14 +158,6 @@ namespace lacerta::cut
     /// Grows the scratch arrays to the mesh (new entries are invalid).
     void
     prepare_scratch();
-    /// The cells the sweep splits (`affected`): those the crossings cut through, the
-    /// cells around the crossings they apply, and the stars of the vertices on the cut
-    /// whose copies are decided again.
-    void
-    select_cells();
-    /// One TetCut per cell of `affected` that changes, into `removed` and `cuts`.
-    void
-    make_cuts();
     /// Replaces `removed` by the children of `results`, copies the vertices on the
     /// cut, updates masses, springs and the active set: the stages below.
     void
@@ -197,19 +190,10 @@ namespace lacerta::cut
     std::vector<std::pair<unsigned int, Point>> blade_cell_positions;
     /// The children of the cells a sweep splits, and the copies of points on the cut.
     ChildBuilder children;
-    // Scratch of the cell selection, kept between sweeps so that no sweep allocates or
-    // clears O(mesh).
-    /// Per cell: in `affected` (stamp), and in the star of a vertex whose copies are
-    /// decided again. Per vertex: its copies are decided in this sweep (stamp).
-    std::vector<unsigned int> tet_mark, separate_mark;
-    /// Per vertex: came onto the cut in this sweep (stamp).
-    std::vector<unsigned int> fresh_mark;
-    std::vector<std::uint8_t> in_star;
-    unsigned int              affected_stamp = 0;
-    /// The cells the sweep changes, the vertices whose copies it decides, the cells it
-    /// removes and those that replace them.
-    std::vector<unsigned int> affected, separated, around, removed, added_ids;
-    std::vector<TetCut>       cuts;
+    /// The cells a sweep changes and how.
+    CellSelection selection;
+    /// The cells the last sweep added, and the split table's results for its cells.
+    std::vector<unsigned int> added_ids;
     std::vector<SplitResult>  results;
     /// The end of the last lap().
     std::chrono::steady_clock::time_point lap_start;

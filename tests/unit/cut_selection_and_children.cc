@@ -1,6 +1,8 @@
-// The children of a sweep's split cells on their own (cut/child_builder.h): one
-// particle per cut edge shared by the cells around it, states interpolated in the
-// parent, faces on the cut flagged, and the points on the cut copied once per side.
+// Two stages of a sweep on their own: the cells it changes (cut/cell_selection.h),
+// and their children (cut/child_builder.h): one particle per cut edge shared by the
+// cells around it, states interpolated in the parent, faces on the cut flagged, and
+// the points on the cut copied once per side.
+#include <lacerta/cut/cell_selection.h>
 #include <lacerta/cut/child_builder.h>
 #include <lacerta/cut/crossing_decisions.h>
 #include <lacerta/mesh/tet_mesh.h>
@@ -38,13 +40,13 @@ namespace
     }
   };
 
-  /// The plane y = @p y swept by a blade along x (z from 2 down to -1), scaled like
-  /// the deformed mesh.
+  /// The plane y = @p y swept by a blade along x from @p x0 to @p x1 (z from 4 down
+  /// to -2), in deformed coordinates.
   cut::SweptTriangles
-  sweep_in_plane_y(const double y)
+  sweep_in_plane_y(const double y, const double x0 = -3, const double x1 = 3)
   {
-    const Point from_tail{{-3, y, 4}}, from_head{{-3, y, -2}};
-    const Point to_tail{{3, y, 4}}, to_head{{3, y, -2}};
+    const Point from_tail{{x0, y, 4}}, from_head{{x0, y, -2}};
+    const Point to_tail{{x1, y, 4}}, to_head{{x1, y, -2}};
     return {{{{from_tail, from_head, to_tail}}, {{to_tail, from_head, to_head}}}};
   }
 } // namespace
@@ -117,4 +119,40 @@ TEST(CutChildBuilder, CellsCutThroughShareTheirEdgesPointsAndCopyThemOncePerSide
   // New points and copies are on the cut of the stroke.
   for (unsigned int v = 5; v < 13; ++v)
     EXPECT_TRUE(decisions.on_cut(v));
+}
+
+
+TEST(CutCellSelection, ACellCutThroughSplitsItsNeighboursThroughTheSharedCutPoints)
+{
+  TwoTets                tets;
+  cut::CrossingDecisions decisions(tets.mesh, *tets.system, 0.05);
+  // The blade comes from x > 0 and stops just past the shared face x = 0: it cuts the
+  // first cell through (edges 0-2, 1-2, 2-3) but not the second (its edge 4-2 is
+  // crossed at x = -1, deformed).
+  decisions.record_sweep({0, 1}, sweep_in_plane_y(1.0, 3, -0.01));
+  ASSERT_TRUE(decisions.decide_cell(0).complete);
+  ASSERT_FALSE(decisions.decide_cell(1).complete);
+
+  cut::CellSelection selection(tets.mesh);
+  selection.select(decisions);
+  // Both cells change: the first is cut through, the second refined through the two
+  // cut points it shares with it (the mesh stays conforming), without separating.
+  ASSERT_EQ(selection.removed().size(), 2u);
+  EXPECT_TRUE(selection.separated().empty());
+  for (std::size_t k = 0; k < 2; ++k)
+  {
+    const cut::TetCut &c         = selection.cuts()[k];
+    const bool         cell      = selection.removed()[k];
+    unsigned int       cut_edges = 0;
+    for (unsigned int e = 0; e < 6; ++e)
+      cut_edges += (c.cut_edges >> e) & 1u;
+    EXPECT_EQ(cut_edges, cell == 0 ? 3u : 2u);
+    const auto sides =
+      std::count(c.vertex_side.begin(), c.vertex_side.end(), c.vertex_side[0]);
+    EXPECT_EQ(sides, cell == 0 ? 3 : 4) << "cell " << cell;
+  }
+  using Key = cut::CrossingDecisions;
+  EXPECT_TRUE(decisions.is_applied(Key::edge_key(0, 2)));
+  EXPECT_TRUE(decisions.is_applied(Key::edge_key(1, 2)));
+  EXPECT_TRUE(decisions.is_applied(Key::edge_key(2, 3)));
 }
