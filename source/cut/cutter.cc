@@ -97,7 +97,6 @@ namespace lacerta::cut
                      lengths.begin() + lengths.size() / 2,
                      lengths.end());
     typical_edge = lengths[lengths.size() / 2];
-    prepare_scratch();
   }
 
 
@@ -214,7 +213,7 @@ namespace lacerta::cut
     }
     const auto t_start = Clock::now();
     lap_start          = t_start;
-    prepare_scratch();
+    decisions.prepare();
     decisions.record_sweep(search.cells(), swept_triangles);
     selection.select(decisions);
     lap(statistics.analysis_seconds);
@@ -230,13 +229,6 @@ namespace lacerta::cut
     }
     statistics.update_seconds +=
       std::chrono::duration<double>(Clock::now() - t_start).count();
-  }
-
-
-  void
-  Cutter::prepare_scratch()
-  {
-    decisions.prepare();
   }
 
 
@@ -288,7 +280,7 @@ namespace lacerta::cut
     added_ids = topology.replace(removed, children.children(), children.face_ids());
     lap(statistics.mesh_seconds);
 
-    prepare_scratch();
+    decisions.prepare();
     clamp_rounded_masses();
     integral_of_density += topology.mass_delta() - mass_before;
     search.follow_replacement(removed, added_ids, end);

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "physics_test_support.h"
+#include <cmath>
 #include <memory>
 
 namespace
@@ -231,4 +232,37 @@ TEST(CutCrossingDecisions, AppliedCrossingsGoAndTheStrokesEndForgetsTheRest)
   tets.decisions->end_stroke();
   EXPECT_EQ(tets.decisions->decide_cell(0).crossed, 0);
   EXPECT_FALSE(tets.decisions->on_cut(2));
+}
+
+
+TEST(CutCrossingDecisions, TheSnappingScaleIsTheLongestEdgeOfTheCellsAroundTheEdge)
+{
+  Tets tets(true);
+  // Edge 0-1 (length 1) lies in the first cell only, whose longest edge is sqrt 2;
+  // edge 0-2 is shared by both cells, whose longest edges are sqrt 2 too.
+  EXPECT_NEAR(tets.decisions->cell_size_around(0, 1), std::sqrt(2.0), 1e-15);
+  EXPECT_NEAR(tets.decisions->cell_size_around(0, 2), std::sqrt(2.0), 1e-15);
+}
+
+
+TEST(CutCrossingDecisions, APartReachesAheadOfTheSweepAndNearItsEarlierSweepsOnly)
+{
+  Tets tets;
+  // The part of the surface in the plane x = 0.1, swept along +y: first from y = -1
+  // to 0.5, then (the sweep being judged) from 0.5 to 0.8.
+  tets.decisions->record_sweep(tets.all_cells(), sweep_in_plane_x(0.1, -1, 0.5));
+  const SweptTriangles current = sweep_in_plane_x(0.1, 0.5, 0.8);
+  // Vertex 2 (y = 1) lies ahead of the sweep's start.
+  EXPECT_TRUE(tets.decisions->part_reaches(2, 0.01, current));
+  // Vertex 0 (y = 0) lies behind it, 0.51 from its triangles but 0.1 from the part's
+  // earlier sweep.
+  EXPECT_TRUE(tets.decisions->part_reaches(0, 0.2, current));
+  EXPECT_FALSE(tets.decisions->part_reaches(0, 0.05, current));
+  // After a corner (the blade now moves along x in a plane y = const, 90 degrees from
+  // the last sweep) the earlier part no longer counts: vertex 0 is not reached.
+  const SweptTriangles corner = {
+    {{{Point{{0.1, 3, 2}}, Point{{0.1, 3, -1}}, Point{{0.5, 3, 2}}}},
+     {{Point{{0.5, 3, 2}}, Point{{0.1, 3, -1}}, Point{{0.5, 3, -1}}}}}};
+  tets.decisions->record_sweep(tets.all_cells(), corner);
+  EXPECT_FALSE(tets.decisions->part_reaches(0, 0.2, current));
 }

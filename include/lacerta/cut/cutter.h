@@ -155,11 +155,8 @@ namespace lacerta::cut
     /// Current position of particle @p v.
     Point
     position(unsigned int v) const;
-    /// Grows the scratch arrays to the mesh (new entries are invalid).
-    void
-    prepare_scratch();
-    /// Replaces `removed` by the children of `results`, copies the vertices on the
-    /// cut, updates masses, springs and the active set: the stages below.
+    /// Replaces the selected cells by their children (ChildBuilder), then updates the
+    /// mesh, masses, springs and the search's active cells (TopologyUpdate, SweepSearch).
     void
     apply(const Blade &end, CutStepStatistics &statistics);
 
