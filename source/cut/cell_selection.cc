@@ -12,8 +12,10 @@ namespace lacerta::cut
 
 
   void
-  CellSelection::reserve(const std::size_t n_tets)
+  CellSelection::reserve(const std::size_t n_tets, const std::size_t n_vertices)
   {
+    separate_mark.reserve(n_vertices);
+    fresh_mark.reserve(n_vertices);
     tet_mark.reserve(n_tets);
     in_star.reserve(n_tets);
   }

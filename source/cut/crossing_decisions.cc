@@ -36,8 +36,9 @@ namespace lacerta::cut
 
 
   void
-  CrossingDecisions::reserve(const std::size_t n_vertices)
+  CrossingDecisions::reserve(const std::size_t n_vertices, const std::size_t n_edges)
   {
+    edge_seen.reserve(n_edges);
     on_surface.reserve(n_vertices);
     crossings_at.reserve(n_vertices);
   }

@@ -86,10 +86,10 @@ namespace lacerta::cut
     mesh.reserve(room(mesh.n_vertices()), room(mesh.n_tets()));
     system.reserve(room(system.n_particles()));
     system.springs.reserve(room(system.springs.size()));
-    decisions.reserve(room(mesh.n_vertices()));
+    decisions.reserve(room(mesh.n_vertices()), room(mesh.n_edges()));
     children.reserve(room(mesh.n_vertices()), room(mesh.n_edges()));
     search.reserve(room(mesh.n_tets()), room(mesh.n_edges()));
-    selection.reserve(room(mesh.n_tets()));
+    selection.reserve(room(mesh.n_tets()), room(mesh.n_vertices()));
     std::vector<double> lengths;
     for (const auto &e : mesh.get_edges())
       lengths.push_back(norm(sub(mesh.vertex(e[1]), mesh.vertex(e[0]))));

@@ -32,9 +32,9 @@ namespace lacerta::cut
     /// A selection on @p mesh.
     explicit CellSelection(const mesh::TetMesh &mesh);
 
-    /// Reserves room for @p n_tets cells.
+    /// Reserves room for @p n_tets cells and @p n_vertices vertices.
     void
-    reserve(std::size_t n_tets);
+    reserve(std::size_t n_tets, std::size_t n_vertices);
 
     /**
      * Selects the cells the last CrossingDecisions::record_sweep() of @p decisions

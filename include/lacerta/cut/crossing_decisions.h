@@ -93,9 +93,9 @@ namespace lacerta::cut
                       const physics::ParticleSystem &system,
                       double                         snap_fraction);
 
-    /// Reserves room for @p n_vertices vertices.
+    /// Reserves room for @p n_vertices vertices and @p n_edges edges.
     void
-    reserve(std::size_t n_vertices);
+    reserve(std::size_t n_vertices, std::size_t n_edges);
 
     /// Grows the per-vertex and per-edge arrays to the mesh (new entries undecided).
     void
