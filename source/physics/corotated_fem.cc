@@ -192,6 +192,12 @@ namespace lacerta::physics
         return 0;
       }
 
+      bool
+      has_element_stiffness() const override
+      {
+        return true;
+      }
+
       void
       for_each_element_stiffness(
         const ParticleSystem                                              &system,

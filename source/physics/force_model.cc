@@ -15,6 +15,13 @@ namespace lacerta::physics
   }
 
 
+  bool
+  ForceModel::has_element_stiffness() const
+  {
+    return false;
+  }
+
+
   void
   ForceModel::for_each_element_stiffness(
     const ParticleSystem &,

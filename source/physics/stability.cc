@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <tuple>
 
@@ -801,6 +802,122 @@ namespace lacerta::physics
           stiffest_spring.data());
       });
     return lambda;
+  }
+
+
+  std::vector<double>
+  isotropic_frequency_bounds(const ParticleSystem      &system,
+                             const std::vector<double> &weights)
+  {
+    if (system.has_force_model() && system.force_model().has_element_stiffness())
+      throw_error("isotropic_frequency_bounds() bounds a force model of springs only.");
+    const unsigned int      n       = system.n_particles();
+    const SpringSet        &springs = system.springs;
+    const double            scale   = spring_scale(system);
+    std::vector<RowFactors> factors;
+    std::vector<double>     up;
+    all_row_factors(system, weights, factors, up);
+    // Row i of weighted_rows(): λ_max(Σ_e (1 + t_e) |K_e|) / m_i, with |K_e| at most
+    // |k_e| times the identity wherever the spring is at least half its rest length.
+    std::vector<double> row(n, 0.0);
+    for (std::size_t s = 0; s < springs.size(); ++s)
+    {
+      const unsigned int i = springs.a[s], j = springs.b[s];
+      const double       k       = std::abs(scale * springs.stiffness[s]);
+      const bool         coupled = system.free[i] > 0 && system.free[j] > 0;
+      row[i] += (1 + (coupled ? factors[i].down * up[j] : 0.0)) * k;
+      row[j] += (1 + (coupled ? factors[j].down * up[i] : 0.0)) * k;
+    }
+    for (unsigned int i = 0; i < n; ++i)
+      row[i] = has_row(system, i) ? row[i] / system.mass[i] : 0.0;
+    return row;
+  }
+
+
+  std::vector<double>
+  spring_motion_allowances(const ParticleSystem      &system,
+                           const double              *reference,
+                           const std::vector<double> &reference_rows,
+                           const std::vector<double> &isotropic,
+                           const double               squared_omega)
+  {
+    const SpringSet &springs = system.springs;
+    // How far row p's springs may turn and stretch, relative to their length at the
+    // reference, before its row can exceed the limit: the row rises by at most
+    // 4 ρ times its isotropic bound when no spring's ends moved by more than ρ of its
+    // reference length (doc/stability.md). A row the isotropic bound settles allows
+    // any motion; a row at or above the limit none.
+    const auto allowance = [&](const unsigned int p)
+    {
+      if (isotropic[p] <= squared_omega)
+        return std::numeric_limits<double>::infinity();
+      const double a = (squared_omega - reference_rows[p]) / (4 * isotropic[p]);
+      return a > 0 ? a : -1.0;
+    };
+    std::vector<double> allowed(springs.size());
+    for (std::size_t s = 0; s < springs.size(); ++s)
+    {
+      const unsigned int i = springs.a[s], j = springs.b[s];
+      const double       rho = std::min(allowance(i), allowance(j));
+      if (rho < 0)
+      {
+        allowed[s] = -1;
+        continue;
+      }
+      if (std::isinf(rho))
+      {
+        allowed[s] = rho;
+        continue;
+      }
+      double squared_length = 0;
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        const double c = reference[3 * j + d] - reference[3 * i + d];
+        squared_length += c * c;
+      }
+      allowed[s] = rho * rho * squared_length;
+    }
+    return allowed;
+  }
+
+
+  void
+  append_ends_of_springs_to_bound_again(const ParticleSystem      &system,
+                                        const double              *x,
+                                        const double              *reference,
+                                        const std::vector<double> &allowed,
+                                        std::vector<unsigned int> &ends)
+  {
+    const SpringSet &springs = system.springs;
+    for (std::size_t s = 0; s < springs.size(); ++s)
+    {
+      const unsigned int i = springs.a[s], j = springs.b[s];
+      double             now[3], length      = 0;
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        now[d] = x[3 * j + d] - x[3 * i + d];
+        length += now[d] * now[d];
+      }
+      const double half = 0.5 * springs.rest_length[s];
+      // Written so that a length that is not a number is bounded again. A spring
+      // whose rows allow any motion needs no reference.
+      bool again = !(length >= half * half);
+      if (!again && !std::isinf(allowed[s]))
+      {
+        double moved = 0;
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          const double c = now[d] - (reference[3 * j + d] - reference[3 * i + d]);
+          moved += c * c;
+        }
+        again = !(moved <= allowed[s]);
+      }
+      if (again)
+      {
+        ends.push_back(i);
+        ends.push_back(j);
+      }
+    }
   }
 
 

@@ -1,8 +1,10 @@
 #include <lacerta/base/archive.h>
 #include <lacerta/mesh/tet_mesh.h>
+#include <lacerta/physics/force_model.h>
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/stability_bound.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace lacerta::physics
@@ -35,6 +37,7 @@ namespace lacerta::physics
     lambda                      = weighted_frequency_bounds(system, terms, weights);
     stiffest                    = terms.stiffest_spring;
     build_tree(system.n_particles());
+    check.clear();
   }
 
 
@@ -63,14 +66,92 @@ namespace lacerta::physics
   }
 
 
+  bool
+  StabilityBound::kept_weights_within(const ParticleSystem &system,
+                                      const double          squared_omega)
+  {
+    const unsigned int n = system.n_particles();
+    if (leaves == 0 || weights.size() != n)
+      return false;
+    const bool springs_only =
+      !(system.has_force_model() && system.force_model().has_element_stiffness());
+    if (!springs_only)
+      return rows_within(system, squared_omega);
+    if (check.isotropic.size() != n)
+      check.isotropic = isotropic_frequency_bounds(system, weights);
+    if (check.rows.size() != n || check.allowed.size() != system.springs.size())
+      return rows_within(system, squared_omega);
+    if (check.limit != squared_omega)
+    {
+      check.allowed = spring_motion_allowances(
+        system, check.position.data(), check.rows, check.isotropic, squared_omega);
+      check.limit = squared_omega;
+    }
+    // The rows the reference does not settle: those at a spring that collapsed or
+    // moved past its allowance.
+    row_mark.resize(n, 0);
+    ++mark;
+    rows.clear();
+    ends.clear();
+    append_ends_of_springs_to_bound_again(
+      system, system.position.data(), check.position.data(), check.allowed, ends);
+    for (const unsigned int p : ends)
+      add_row(p);
+    if (rows.empty())
+      return true;
+    // Those are bounded from the springs around them (the mesh's stars, whose edges
+    // must be the springs), unless they are many: then every row is, and the current
+    // positions become the reference.
+    if (!has_local_rows(system) || rows.size() > n / 4)
+      return rows_within(system, squared_omega);
+    bound_rows(system, 0);
+    return std::all_of(row_lambda.begin(),
+                       row_lambda.end(),
+                       [&](const double l) { return l <= squared_omega; });
+  }
+
+
+  bool
+  StabilityBound::rows_within(const ParticleSystem &system, const double squared_omega)
+  {
+    std::vector<unsigned int> spring;
+    std::vector<double>       all =
+      weighted_frequency_bounds_at(system, system.position.data(), weights, spring);
+    const bool within = std::all_of(all.begin(),
+                                    all.end(),
+                                    [&](const double l) { return l <= squared_omega; });
+    // For a force model of springs only, these positions and rows are the reference
+    // of the next checks (unneeded if the bound is computed anew, which clears them).
+    check.rows.clear();
+    check.allowed.clear();
+    if (within && check.isotropic.size() == system.n_particles())
+    {
+      check.position = system.position;
+      check.rows     = std::move(all);
+      check.allowed  = spring_motion_allowances(
+        system, check.position.data(), check.rows, check.isotropic, squared_omega);
+      check.limit = squared_omega;
+    }
+    return within;
+  }
+
+
+  void
+  StabilityBound::CheckReference::clear()
+  {
+    isotropic.clear();
+    rows.clear();
+    allowed.clear();
+  }
+
+
   void
   StabilityBound::update(const ParticleSystem            &system,
                          const std::vector<unsigned int> &changed)
   {
+    check.clear();
     // The local rows walk the mesh's stars, whose edges are the springs.
-    if (system.mesh == nullptr || !system.mesh->has_local_updates() || leaves == 0
-        || system.all_particles_changed()
-        || system.mesh->n_edges() != system.springs.size())
+    if (!has_local_rows(system) || leaves == 0 || system.all_particles_changed())
     {
       compute(system);
       return;
@@ -106,6 +187,23 @@ namespace lacerta::physics
     const std::size_t n_reweighted = rows.size();
     for (std::size_t r = 0; r < n_reweighted; ++r)
       add_star(system, rows[r]);
+    bound_rows(system, n_reweighted);
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      set(rows[r], row_lambda[r], row_spring[r]);
+  }
+
+
+  bool
+  StabilityBound::has_local_rows(const ParticleSystem &system)
+  {
+    return system.mesh != nullptr && system.mesh->has_local_updates()
+           && system.mesh->n_edges() == system.springs.size();
+  }
+
+
+  void
+  StabilityBound::bound_rows(const ParticleSystem &system, const std::size_t n_reweighted)
+  {
     row_lambda.resize(rows.size());
     row_spring.resize(rows.size());
     gershgorin_rows(system,
@@ -117,8 +215,6 @@ namespace lacerta::physics
                     scratch,
                     row_lambda.data(),
                     row_spring.data());
-    for (std::size_t r = 0; r < rows.size(); ++r)
-      set(rows[r], row_lambda[r], row_spring[r]);
   }
 
 
@@ -203,5 +299,7 @@ namespace lacerta::physics
   {
     archive.section("stability bound");
     archive(lambda, stiffest, first_weights, weights, tree, leaves);
+    // The periodic check's reference is worked out again at the next check.
+    check.clear();
   }
 } // namespace lacerta::physics

@@ -181,6 +181,12 @@ namespace lacerta::physics
         return energy;
       }
 
+      bool
+      has_element_stiffness() const override
+      {
+        return true;
+      }
+
       void
       for_each_element_stiffness(
         const ParticleSystem &,

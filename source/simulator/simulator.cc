@@ -29,6 +29,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <numeric>
 #include <sstream>
 #include <thread>
@@ -450,6 +451,42 @@ namespace lacerta
   }
 
 
+  double
+  Simulator::largest_kept_squared_frequency(const unsigned int substeps)
+  {
+    if (kept_frequency_limit.first == substeps)
+      return kept_frequency_limit.second;
+    const auto keeps = [&](const double omega)
+    {
+      physics::FrequencyBound b;
+      b.omega = omega;
+      return keeps_substeps(b, substeps);
+    };
+    // Bracket the limit by doubling, then halve the bracket until its ends are
+    // neighbouring doubles; the lower end keeps the sub-steps.
+    double low = 0, high = 1;
+    while (keeps(high) && high < std::numeric_limits<double>::max() / 2)
+    {
+      low = high;
+      high *= 2;
+    }
+    double limit = std::numeric_limits<double>::infinity();
+    if (!keeps(high))
+    {
+      for (unsigned int k = 0; k < 2100; ++k)
+      {
+        const double middle = low + 0.5 * (high - low);
+        if (middle <= low || middle >= high)
+          break;
+        (keeps(middle) ? low : high) = middle;
+      }
+      limit = low * low;
+    }
+    kept_frequency_limit = {substeps, limit};
+    return limit;
+  }
+
+
   unsigned int
   Simulator::choose_substeps(const physics::FrequencyBound &bound,
                              const unsigned int             current)
@@ -776,19 +813,18 @@ namespace lacerta
     {
       monitor->check(system, step, state.time);
       // The limit falls when an element collapses (the geometric stiffness of a
-      // strongly compressed spring) without any change of the system: keeping the
-      // sub-steps chosen at the last change let the severed kidney pole blow up.
-      // The bound with the row weights kept from the last change holds at the current
-      // positions and is at least the fresh one, so it decides alone while it allows
-      // the current sub-steps (the decision is then that of a fresh bound); only
+      // strongly compressed spring) without any change of the system. The bound with
+      // the row weights kept from the last change holds at the current positions and
+      // is at least the fresh one, so it decides alone while every row allows the
+      // current sub-steps (the decision is then that of a fresh bound); only
       // otherwise are the weights chosen again and the bound kept.
-      if (substep_when_unstable)
-        if (const auto kept = stability_bound->bound_with_kept_weights(system);
-            !kept || !keeps_substeps(*kept, state.substeps))
-        {
-          stability_bound->compute(system);
-          state.substeps = choose_substeps(stability_bound->bound(), state.substeps);
-        }
+      if (substep_when_unstable
+          && !stability_bound->kept_weights_within(
+            system, largest_kept_squared_frequency(state.substeps)))
+      {
+        stability_bound->compute(system);
+        state.substeps = choose_substeps(stability_bound->bound(), state.substeps);
+      }
     }
     if (needs_energies)
     {

@@ -11,8 +11,10 @@
 
 #include "mt_test_support.h"
 #include "physics_test_support.h"
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -86,6 +88,175 @@ namespace lacerta
         }
       }
     EXPECT_EQ(n_compared, 3u * 3u * 16u);
+  }
+
+
+  TEST(StabilityBound, ThePeriodicCheckAgreesWithTheHighestRowWithKeptWeights)
+  {
+    // kept_weights_within() settles most rows without bounding them; in any sequence
+    // of positions, for every force model and every limit, it must say what the
+    // highest row of bound_with_kept_weights() says. Positions: a cut slab moving
+    // away from its rest shape step by step (so that the check's reference ages),
+    // with or without springs collapsed below half their rest length; limits around
+    // the highest row.
+    std::mt19937 random(11);
+    unsigned int n_compared = 0, n_within = 0;
+    for (const std::string model : {"linear springs", "volume springs", "corotated fem"})
+    {
+      auto                     scene  = slab_cut_scene(model, 0.01, 0.07, -0.02, -0.07);
+      physics::ParticleSystem &system = *scene->system;
+      for (unsigned int k = 1; k <= 8; ++k)
+        scene->cut(scene->tool->blade(k / 16.0), 0.01 * k);
+      system.clear_changes();
+      physics::StabilityBound bound;
+      bound.compute(system);
+      std::vector<double>                    drift(system.position.size());
+      std::uniform_real_distribution<double> unit(-1, 1);
+      for (double &d : drift)
+        d = unit(random);
+      // A motion that raises the highest row past the limit after the check took its
+      // reference is caught.
+      {
+        const auto squared_highest = [&]()
+        {
+          const double omega = bound.bound_with_kept_weights(system)->omega;
+          return omega * omega;
+        };
+        const std::vector<double> start = system.position;
+        const double              h0    = squared_highest();
+        EXPECT_TRUE(bound.kept_weights_within(system, 100 * h0));
+        double h1 = h0;
+        for (double scale = 1e-5; h1 < 1.02 * h0 && scale < 0.1; scale *= 1.2)
+        {
+          for (std::size_t c = 0; c < drift.size(); ++c)
+            system.position[c] = start[c] + scale * drift[c];
+          h1 = squared_highest();
+        }
+        ASSERT_GT(h1, 1.02 * h0) << model;
+        EXPECT_FALSE(bound.kept_weights_within(system, std::sqrt(h0 * h1))) << model;
+        EXPECT_TRUE(bound.kept_weights_within(system, 1.001 * h1)) << model;
+        system.position = start;
+      }
+      for (const double amplitude : {0.0, 1e-5, 1e-4, 3e-4, 2e-3})
+        for (const bool collapse : {false, true})
+        {
+          const std::vector<double> before = system.position;
+          for (std::size_t c = 0; c < drift.size(); ++c)
+            system.position[c] += amplitude * (drift[c] + 0.3 * unit(random));
+          const std::size_t squeezed = system.springs.size() / 2;
+          if (collapse)
+          {
+            // A spring squeezed to a tenth of its rest length.
+            const unsigned int a = system.springs.a[squeezed],
+                               b = system.springs.b[squeezed];
+            for (unsigned int d = 0; d < 3; ++d)
+              system.position[3 * b + d] =
+                system.position[3 * a + d]
+                + 0.1 * (system.position[3 * b + d] - system.position[3 * a + d]);
+          }
+          const std::optional<physics::FrequencyBound> kept =
+            bound.bound_with_kept_weights(system);
+          ASSERT_TRUE(kept.has_value());
+          const double highest = kept->omega * kept->omega;
+          for (const double factor : {100.0, 3.0, 1.1, 1.001, 0.999, 0.9, 0.2})
+          {
+            EXPECT_EQ(bound.kept_weights_within(system, factor * highest),
+                      highest <= factor * highest)
+              << model << ", amplitude " << amplitude << ", collapse " << collapse
+              << ", limit " << factor << " x the highest row";
+            n_within += factor > 1;
+            ++n_compared;
+          }
+          if (collapse)
+            system.position = before;
+        }
+    }
+    EXPECT_EQ(n_compared, 3u * 5u * 2u * 7u);
+    EXPECT_EQ(n_within, 3u * 5u * 2u * 4u);
+  }
+
+
+  TEST(StabilityBound, TheCheckSettlesRowsByTheBoundsItsReferenceGives)
+  {
+    // The inequalities the periodic check rests on, for springs only: every row is at
+    // most its isotropic bound, and at most its row at a reference plus 4 rho times
+    // its isotropic bound when no spring at it moved by more than rho of its
+    // reference length; a spring squeezed below half its rest length is found.
+    auto scene = slab_cut_scene("linear springs", 0.01, 0.07, -0.02, -0.07);
+    physics::ParticleSystem &system = *scene->system;
+    for (unsigned int k = 1; k <= 8; ++k)
+      scene->cut(scene->tool->blade(k / 16.0), 0.01 * k);
+    physics::StabilityBound bound;
+    bound.compute(system);
+    const std::vector<double> &weights = bound.row_weights();
+    const std::vector<double>  isotropic =
+      physics::isotropic_frequency_bounds(system, weights);
+    std::vector<unsigned int> spring;
+    const std::vector<double> reference = system.position;
+    const std::vector<double> reference_rows =
+      physics::weighted_frequency_bounds_at(system, reference.data(), weights, spring);
+    std::mt19937                           random(5);
+    std::uniform_real_distribution<double> unit(-1, 1);
+    unsigned int                           n_tight = 0;
+    for (const double amplitude : {1e-5, 1e-4, 5e-4})
+    {
+      system.position = reference;
+      for (double &x : system.position)
+        x += amplitude * unit(random);
+      const std::vector<double> rows = physics::weighted_frequency_bounds_at(
+        system, system.position.data(), weights, spring);
+      // The largest relative motion of a spring at each particle.
+      std::vector<double> rho(system.n_particles(), 0.0);
+      for (std::size_t s = 0; s < system.springs.size(); ++s)
+      {
+        const unsigned int a = system.springs.a[s], b = system.springs.b[s];
+        double             moved = 0, length = 0;
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          const double now  = system.position[3 * b + d] - system.position[3 * a + d];
+          const double then = reference[3 * b + d] - reference[3 * a + d];
+          moved += (now - then) * (now - then);
+          length += then * then;
+        }
+        for (const unsigned int p : {a, b})
+          rho[p] = std::max(rho[p], std::sqrt(moved / length));
+      }
+      for (unsigned int p = 0; p < system.n_particles(); ++p)
+      {
+        EXPECT_LE(rows[p], isotropic[p] * (1 + 1e-12)) << "particle " << p;
+        const double bound_by_motion = reference_rows[p] + 4 * rho[p] * isotropic[p];
+        EXPECT_LE(rows[p], bound_by_motion * (1 + 1e-12)) << "particle " << p;
+        n_tight += bound_by_motion < isotropic[p];
+      }
+    }
+    // The motion bound is the tighter one for small motions (else the check would
+    // gain nothing over the isotropic rows).
+    EXPECT_GT(n_tight, system.n_particles());
+    // A squeezed spring is found, and so is a spring that moved past its allowance.
+    system.position = reference;
+    std::vector<double>       any_motion(system.springs.size(),
+                                   std::numeric_limits<double>::infinity());
+    std::vector<unsigned int> ends;
+    physics::append_ends_of_springs_to_bound_again(
+      system, system.position.data(), reference.data(), any_motion, ends);
+    EXPECT_TRUE(ends.empty());
+    const unsigned int a = system.springs.a[7], b = system.springs.b[7];
+    for (unsigned int d = 0; d < 3; ++d)
+      system.position[3 * b + d] =
+        reference[3 * a + d] + 0.4 * (reference[3 * b + d] - reference[3 * a + d]);
+    physics::append_ends_of_springs_to_bound_again(
+      system, system.position.data(), reference.data(), any_motion, ends);
+    EXPECT_NE(std::find(ends.begin(), ends.end(), b), ends.end());
+    ends.clear();
+    system.position = reference;
+    system.position[3 * b] += 1e-6;
+    std::vector<double> little(system.springs.size(), 1e-14);
+    physics::append_ends_of_springs_to_bound_again(
+      system, system.position.data(), reference.data(), little, ends);
+    EXPECT_NE(std::find(ends.begin(), ends.end(), b), ends.end());
+    // The isotropic rows are for springs only.
+    auto fem = slab_cut_scene("corotated fem", 0.01, 0.07, -0.02, -0.07);
+    EXPECT_ANY_THROW(physics::isotropic_frequency_bounds(*fem->system, weights));
   }
 
 

@@ -114,6 +114,14 @@ namespace lacerta::physics
     virtual const ParticleRanges &
     particle_ranges() const = 0;
 
+    /**
+     * Whether the model has a per-tetrahedron term besides the springs (what
+     * for_each_element_stiffness() visits): false for a model of springs only, whose
+     * stability bound then depends on the positions through the springs alone.
+     */
+    virtual bool
+    has_element_stiffness() const;
+
     /// A 12x12 tangent stiffness of a tetrahedron, rows and columns ordered (local
     /// vertex, component), row-major.
     using ElementStiffness = std::array<double, 144>;

@@ -119,6 +119,52 @@ namespace lacerta::physics
                                std::vector<unsigned int> &stiffest_spring);
 
   /**
+   * Upper bounds of the rows of weighted_frequency_bounds_at() with @p weights that
+   * hold at every positions where no spring is shorter than half its rest length, for
+   * a force model of springs only (ForceModel::has_element_stiffness() false; throws
+   * otherwise). There a spring's term |K_e| has the eigenvalues |k_e| (along the
+   * spring) and |k_e (1 - L_e / l_e)| <= |k_e|, so row i is at most
+   * Σ_e (1 + t_e) |k_e| / m_i, whatever the springs' directions: one pass over the
+   * springs without a square root per spring, to be done again only when masses,
+   * stiffnesses or weights change.
+   */
+  std::vector<double>
+  isotropic_frequency_bounds(const ParticleSystem      &system,
+                             const std::vector<double> &weights);
+
+  /**
+   * For the periodic check of a force model of springs only: how far (squared) the
+   * ends of each spring may move relative to each other from @p reference positions
+   * before the rows at its ends may exceed @p squared_omega (rad²/s²), given the rows
+   * @p reference_rows of weighted_frequency_bounds_at() there and the
+   * isotropic_frequency_bounds() @p isotropic with the same weights. While a spring is
+   * at least half its rest length, its term |K_e| moves by at most 4 |k_e| ρ when its
+   * ends moved by ρ of its reference length (doc/stability.md), so a row rises by at
+   * most 4 ρ times its isotropic bound. Infinite where both ends' isotropic rows are
+   * within the limit, negative where a reference row is not below it.
+   */
+  std::vector<double>
+  spring_motion_allowances(const ParticleSystem      &system,
+                           const double              *reference,
+                           const std::vector<double> &reference_rows,
+                           const std::vector<double> &isotropic,
+                           double                     squared_omega);
+
+  /**
+   * Appends to @p ends both ends of every spring whose rows the periodic check must
+   * bound again at @p positions: shorter than half its rest length (or of a length
+   * that is not a number), or whose ends moved relative to each other since
+   * @p reference by more than its allowance @p allowed (spring_motion_allowances()).
+   * One pass over the springs without a square root.
+   */
+  void
+  append_ends_of_springs_to_bound_again(const ParticleSystem      &system,
+                                        const double              *positions,
+                                        const double              *reference,
+                                        const std::vector<double> &allowed,
+                                        std::vector<unsigned int> &ends);
+
+  /**
    * The weight d_i of a row for weighted_frequency_bounds(), from its block Gershgorin
    * bound with all weights 1 (squared_frequency_bounds()), @p unscaled_row: that bound
    * itself (1 if it is 0, for a particle without a row; a NaN stays NaN, so that the

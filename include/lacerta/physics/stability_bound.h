@@ -46,6 +46,23 @@ namespace lacerta::physics
     bound_with_kept_weights(const ParticleSystem &system) const;
 
     /**
+     * Whether the bound with the kept row weights at the current positions (that of
+     * bound_with_kept_weights()) is at most @p squared_omega (rad²/s²) at every
+     * particle: false also if a row is not a number, or if compute() was never called
+     * or the number of particles changed since. The answer is always that of the
+     * highest row, but for a force model of springs only most rows are settled
+     * without being bounded (doc/stability.md, "Blow-up detection"): against the
+     * positions and rows of the last check that bounded every row, by one pass over
+     * the springs that finds those that collapsed below half their rest length or
+     * whose ends moved past their allowance (spring_motion_allowances()). Only the
+     * rows at those springs are bounded at the current positions (gershgorin_rows()),
+     * unless they are more than a quarter of the particles: then every row is
+     * (weighted_frequency_bounds_at()), and the positions become the reference.
+     */
+    bool
+    kept_weights_within(const ParticleSystem &system, double squared_omega);
+
+    /**
      * Updates the bound after a local change of the system: the particles listed in
      * @p changed (ParticleSystem::changed_particles(), repeats allowed) and the
      * appended ones get new weights (gershgorin_row_weight(), refined_row_weight()),
@@ -87,6 +104,16 @@ namespace lacerta::physics
     void
     build_tree(unsigned int n);
 
+    /// Whether the rows of @p system can be bounded locally: it has a mesh with local
+    /// updates whose edges are its springs (gershgorin_rows() walks their stars).
+    static bool
+    has_local_rows(const ParticleSystem &system);
+
+    /// Bounds the particles in `rows` at the current positions into `row_lambda` and
+    /// `row_spring`, the first @p n_reweighted with new weights (gershgorin_rows()).
+    void
+    bound_rows(const ParticleSystem &system, std::size_t n_reweighted);
+
     /// Appends particle @p p to `rows` unless it holds it (marked with `mark`).
     void
     add_row(unsigned int p);
@@ -121,6 +148,29 @@ namespace lacerta::physics
     /// in `row_mark` with the update's `mark`.
     std::vector<unsigned int> rows, row_mark;
     unsigned int              mark = 0;
+    /// Bounds every row at the current positions with the kept weights: whether all
+    /// are at most @p squared_omega; keeps them as the check's reference if so.
+    bool
+    rows_within(const ParticleSystem &system, double squared_omega);
+
+    /**
+     * What kept_weights_within() settles rows with, for a force model of springs
+     * only: the isotropic_frequency_bounds() with `weights`; the positions and rows of
+     * the last check that bounded every row, and the allowance of each spring for
+     * the limit `limit` (spring_motion_allowances()). Empty until a check needs them
+     * after a compute(), update() or checkpoint.
+     */
+    struct CheckReference
+    {
+      std::vector<double> isotropic, position, rows, allowed;
+      double              limit = 0;
+      /// Forgets everything (the masses, springs or weights changed).
+      void
+      clear();
+    };
+    CheckReference check;
+    /// The ends of the springs a check bounds again.
+    std::vector<unsigned int> ends;
     std::vector<double>       row_lambda;
     std::vector<unsigned int> row_spring;
     GershgorinRowScratch      scratch;

@@ -208,6 +208,16 @@ namespace lacerta
     keeps_substeps(const physics::FrequencyBound &bound, unsigned int substeps) const;
 
     /**
+     * The largest squared frequency ω² (rad²/s²) under which @p substeps sub-steps per
+     * time step are stable (keeps_substeps(), which is taken to hold below a frequency
+     * and fail above it), to the last bits: the limit the periodic re-check compares
+     * each particle's row with. Infinite if every frequency keeps them. Kept for the
+     * last @p substeps asked.
+     */
+    double
+    largest_kept_squared_frequency(unsigned int substeps);
+
+    /**
      * Checks the time step against the stability limit @p bound of the current state;
      * returns the sub-step count. @p current sub-steps, if given and still below the
      * limit, are kept without a report.
@@ -233,6 +243,8 @@ namespace lacerta
     double       safety_factor;
     double       energy_tolerance;
     unsigned int check_interval;
+    /// The sub-step count and limit of the last largest_kept_squared_frequency().
+    std::pair<unsigned int, double> kept_frequency_limit{0, 0.0};
     /// 'Stability/Maximum sub-steps': more sub-steps per step stop the run.
     unsigned int                                             max_substeps;
     std::unique_ptr<scene::Scene>                            scene;
