@@ -114,6 +114,11 @@ namespace lacerta::physics
     void
     bound_rows(const ParticleSystem &system, std::size_t n_reweighted);
 
+    /// Bounds every row at the current positions with the kept weights: whether all
+    /// are at most @p squared_omega; keeps them as the check's reference if so.
+    bool
+    rows_within(const ParticleSystem &system, double squared_omega);
+
     /// Appends particle @p p to `rows` unless it holds it (marked with `mark`).
     void
     add_row(unsigned int p);
@@ -144,15 +149,11 @@ namespace lacerta::physics
     unsigned int                  leaves = 0;
     static constexpr unsigned int none   = static_cast<unsigned int>(-1);
 
-    /// The rows of an update (the changed particles and their neighbours), marked
-    /// in `row_mark` with the update's `mark`.
+    /// The rows of an update (the changed particles and their neighbours) or of a
+    /// periodic check (the ends of the springs it bounds again), marked in `row_mark`
+    /// with the call's `mark`.
     std::vector<unsigned int> rows, row_mark;
     unsigned int              mark = 0;
-    /// Bounds every row at the current positions with the kept weights: whether all
-    /// are at most @p squared_omega; keeps them as the check's reference if so.
-    bool
-    rows_within(const ParticleSystem &system, double squared_omega);
-
     /**
      * What kept_weights_within() settles rows with, for a force model of springs
      * only: the isotropic_frequency_bounds() with `weights`; the positions and rows of
@@ -171,6 +172,7 @@ namespace lacerta::physics
     CheckReference check;
     /// The ends of the springs a check bounds again.
     std::vector<unsigned int> ends;
+    /// The bounds and stiffest springs of `rows` (bound_rows()), and its scratch.
     std::vector<double>       row_lambda;
     std::vector<unsigned int> row_spring;
     GershgorinRowScratch      scratch;
