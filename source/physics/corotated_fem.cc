@@ -138,13 +138,15 @@ namespace lacerta::physics
       compute_acceleration(const ParticleSystem &system,
                            const double         *x,
                            const double         *v,
-                           double               *a) const override
+                           double               *a,
+                           const RangeUpdate     update) const override
       {
         ranges.for_each_part(
           [&](const unsigned int p)
           {
             element_forces_of_part(system, p, x, v, a);
             ranges.finish_accelerations(system, p, v, a);
+            update(ranges.begin(p), ranges.end(p));
           });
       }
 

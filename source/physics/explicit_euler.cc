@@ -2,10 +2,9 @@
 
 #include <lacerta/physics/particle_system.h>
 #include <lacerta/physics/single_evaluation_integrator.h>
-#include <lacerta/physics/system_ranges.h>
 
 #include <cmath>
-#include <vector>
+#include <cstddef>
 
 namespace lacerta::physics
 {
@@ -29,19 +28,19 @@ namespace lacerta::physics
       void
       step(ParticleSystem &system, const double t, const double dt) override
       {
-        double *x = system.position.data();
-        double *v = system.velocity.data();
-        system.compute_acceleration(x, v, acceleration.data());
-        for_each_coordinate_range(system,
-                                  [&](const std::size_t begin, const std::size_t end)
-                                  {
-                                    for (std::size_t i = begin; i < end; ++i)
-                                    {
-                                      x[i] += dt * v[i];
-                                      v[i] += dt * acceleration[i];
-                                    }
-                                  });
-        system.enforce_constraints(t + dt, x, v);
+        // Each thread updates its particles as soon as their accelerations are known.
+        advance(system,
+                t,
+                dt,
+                [dt](const double x,
+                     const double v,
+                     const double a,
+                     double      &x_next,
+                     double      &v_next)
+                {
+                  x_next = x + dt * v;
+                  v_next = v + dt * a;
+                });
       }
 
       double

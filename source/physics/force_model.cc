@@ -8,6 +8,16 @@ namespace lacerta::physics
   }
 
 
+  void
+  ForceModel::compute_acceleration(const ParticleSystem &system,
+                                   const double         *x,
+                                   const double         *v,
+                                   double               *a) const
+  {
+    compute_acceleration(system, x, v, a, [](unsigned int, unsigned int) {});
+  }
+
+
   double
   ForceModel::spring_stiffness_scale() const
   {

@@ -60,4 +60,16 @@ namespace lacerta::physics
     // a nonlinear force.
     return std::min(symplectic_linear_stability_limit(omega, c), std::sqrt(2.0) / omega);
   }
+
+
+  void
+  resize_like(std::vector<double> &buffer, const std::vector<double> &state)
+  {
+    if (buffer.capacity() < state.capacity())
+    {
+      buffer.clear();
+      buffer.reserve(state.capacity());
+    }
+    buffer.resize(state.size());
+  }
 } // namespace lacerta::physics

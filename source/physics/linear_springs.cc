@@ -95,6 +95,33 @@ namespace lacerta::physics
     }
 
 
+    /// The elastic energy ½ Σ k (L - L0)² of @p set at positions @p x, times @p weight.
+    double
+    energy_of(const SpringSet &set, const double *x, const double weight)
+    {
+      double sum = 0;
+      for (std::size_t s = 0; s < set.size(); ++s)
+      {
+        const unsigned int i = 3 * set.a[s], j = 3 * set.b[s];
+        const double dx = x[j] - x[i], dy = x[j + 1] - x[i + 1], dz = x[j + 2] - x[i + 2];
+        const double stretch =
+          std::sqrt(dx * dx + dy * dy + dz * dz) - set.rest_length[s];
+        sum += set.stiffness[s] * stretch * stretch;
+      }
+      return 0.5 * weight * sum;
+    }
+
+
+    /// Whether spring @p s of @p system joins two particles whose motion is
+    /// prescribed: its forces act on no free particle.
+    bool
+    is_held(const ParticleSystem &system, const unsigned int s)
+    {
+      return system.free[system.springs.a[s]] == 0
+             && system.free[system.springs.b[s]] == 0;
+    }
+
+
     constexpr unsigned int none = static_cast<unsigned int>(-1);
 
     /// A spring with no copies.
@@ -136,16 +163,17 @@ namespace lacerta::physics
   void
   LinearSprings::initialize(const ParticleSystem &system, const unsigned int n_threads)
   {
-    // Balance the ranges by the number of spring ends they hold.
+    // Balance the ranges by the number of spring ends they evaluate.
     std::vector<std::size_t> ends(system.n_particles(), 0);
-    for (std::size_t s = 0; s < system.springs.size(); ++s)
-    {
-      ++ends[system.springs.a[s]];
-      ++ends[system.springs.b[s]];
-    }
+    for (unsigned int s = 0; s < system.springs.size(); ++s)
+      if (!is_held(system, s))
+      {
+        ++ends[system.springs.a[s]];
+        ++ends[system.springs.b[s]];
+      }
     ranges.split(system, ends, n_threads);
 
-    segments.assign(2 * ranges.n_parts(), Segment());
+    segments.assign(2 * ranges.n_parts() + 1, Segment());
     holders.assign(system.springs.size(), no_holders());
     pending_erase.assign(segments.size(), {});
     pending_insert.assign(segments.size(), {});
@@ -227,13 +255,15 @@ namespace lacerta::physics
   LinearSprings::compute_acceleration(const ParticleSystem &system,
                                       const double         *x,
                                       const double         *v,
-                                      double               *a) const
+                                      double               *a,
+                                      const RangeUpdate     update) const
   {
     ranges.for_each_part(
       [&](const unsigned int p)
       {
         spring_forces_of_part(system, p, x, v, a);
         ranges.finish_accelerations(system, p, v, a);
+        update(ranges.begin(p), ranges.end(p));
       });
   }
 
@@ -246,6 +276,29 @@ namespace lacerta::physics
   {
     ranges.for_each_part([&](const unsigned int p)
                          { spring_forces_of_part(system, p, x, v, f); });
+    add_held_spring_forces(system, x, v, f);
+  }
+
+
+  void
+  LinearSprings::add_held_spring_forces(const ParticleSystem &system,
+                                        const double         *x,
+                                        const double         *v,
+                                        double               *f) const
+  {
+    const SpringSet &held = segments.back().set;
+    if (system.spring_damping > 0)
+      add_spring_forces<true, true, false>(
+        held, 0, held.size(), x, v, system.spring_damping, f);
+    else
+      add_spring_forces<false, true, false>(held, 0, held.size(), x, v, 0.0, f);
+  }
+
+
+  unsigned int
+  LinearSprings::held_segment() const
+  {
+    return static_cast<unsigned int>(segments.size() - 1);
   }
 
 
@@ -259,24 +312,10 @@ namespace lacerta::physics
     ranges.for_each_part(
       [&](const unsigned int p)
       {
-        const auto energy_of = [x](const SpringSet &set, const double weight)
-        {
-          double sum = 0;
-          for (std::size_t s = 0; s < set.size(); ++s)
-          {
-            const unsigned int i = 3 * set.a[s], j = 3 * set.b[s];
-            const double       dx = x[j] - x[i], dy = x[j + 1] - x[i + 1],
-                         dz = x[j + 2] - x[i + 2];
-            const double stretch =
-              std::sqrt(dx * dx + dy * dy + dz * dz) - set.rest_length[s];
-            sum += set.stiffness[s] * stretch * stretch;
-          }
-          return 0.5 * weight * sum;
-        };
-        part_energy[p] =
-          energy_of(segments[2 * p].set, 1.0) + energy_of(segments[2 * p + 1].set, 0.5);
+        part_energy[p] = energy_of(segments[2 * p].set, x, 1.0)
+                         + energy_of(segments[2 * p + 1].set, x, 0.5);
       });
-    double energy = 0;
+    double energy = energy_of(segments.back().set, x, 1.0);
     for (const double e : part_energy)
       energy += e;
     return energy;
@@ -323,7 +362,9 @@ namespace lacerta::physics
     const double       k = stiffness_scale * all.stiffness[s];
     // (segment, first end, second end) of each copy.
     std::array<std::array<unsigned int, 3>, 2> wanted = {{{2 * pa, a, b}, {none, 0, 0}}};
-    if (pa != pb)
+    if (is_held(system, s))
+      wanted[0][0] = held_segment();
+    else if (pa != pb)
       wanted = {{{2 * pa + 1, a, b}, {2 * pb + 1, b, a}}};
     for (const unsigned int g : holders[s])
       if (g != none && g != wanted[0][0] && g != wanted[1][0])

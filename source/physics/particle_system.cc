@@ -184,8 +184,18 @@ namespace lacerta::physics
   void
   ParticleSystem::compute_acceleration(const double *x, const double *v, double *a) const
   {
+    compute_acceleration(x, v, a, [](unsigned int, unsigned int) {});
+  }
+
+
+  void
+  ParticleSystem::compute_acceleration(const double     *x,
+                                       const double     *v,
+                                       double           *a,
+                                       const RangeUpdate update) const
+  {
     const auto start = std::chrono::steady_clock::now();
-    forces->compute_acceleration(*this, x, v, a);
+    forces->compute_acceleration(*this, x, v, a, update);
     force_seconds +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }

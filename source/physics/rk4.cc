@@ -3,9 +3,10 @@
 #include <lacerta/base/archive.h>
 #include <lacerta/physics/integrator.h>
 #include <lacerta/physics/particle_system.h>
-#include <lacerta/physics/system_ranges.h>
 
+#include <array>
 #include <cmath>
+#include <cstddef>
 #include <vector>
 
 namespace lacerta::physics
@@ -32,58 +33,78 @@ namespace lacerta::physics
         // Every stage writes its arrays before reading them: growing them is enough,
         // and costs the new particles only (nothing global per cut).
         const std::size_t n = system.position.size();
-        for (auto *v : {&x_stage, &v_stage, &a_stage, &dx_sum, &dv_sum})
+        for (auto *v : {&x_stage[0],
+                        &x_stage[1],
+                        &v_stage[0],
+                        &v_stage[1],
+                        &a_stage,
+                        &dx_sum,
+                        &dv_sum})
           v->resize(n);
       }
 
       void
       step(ParticleSystem &system, const double t, const double dt) override
       {
-        double *x = system.position.data();
-        double *v = system.velocity.data();
-
-        // Stage 1 at (x, v).
-        system.compute_acceleration(x, v, a_stage.data());
-        for_each_coordinate_range(system,
-                                  [&](const std::size_t begin, const std::size_t end)
-                                  {
-                                    for (std::size_t i = begin; i < end; ++i)
+        double      *x = system.position.data(), *v = system.velocity.data();
+        const double half = 0.5 * dt, sixth = dt / 6.0;
+        double      *a = a_stage.data(), *dx = dx_sum.data(), *dv = dv_sum.data();
+        double      *x0 = x_stage[0].data(), *v0 = v_stage[0].data();
+        double      *x1 = x_stage[1].data(), *v1 = v_stage[1].data();
+        // Each thread updates its particles as soon as their accelerations are known.
+        // A stage reads one pair of stage arrays and writes the other, since the other
+        // threads may still read the state evaluated; the last stage evaluates at a
+        // stage state, so it updates (x, v) in place.
+        system.compute_acceleration(x,
+                                    v,
+                                    a,
+                                    [=](const unsigned int begin, const unsigned int end)
                                     {
-                                      dx_sum[i]  = v[i];
-                                      dv_sum[i]  = a_stage[i];
-                                      x_stage[i] = x[i] + 0.5 * dt * v[i];
-                                      v_stage[i] = v[i] + 0.5 * dt * a_stage[i];
-                                    }
-                                  });
-        // Stages 2 and 3 at the midpoint, with weights 2.
-        for (const double to_next : {0.5 * dt, dt})
-        {
-          system.compute_acceleration(x_stage.data(), v_stage.data(), a_stage.data());
-          for_each_coordinate_range(system,
-                                    [&](const std::size_t begin, const std::size_t end)
-                                    {
-                                      for (std::size_t i = begin; i < end; ++i)
+                                      for (std::size_t i = 3 * std::size_t(begin);
+                                           i < 3 * std::size_t(end);
+                                           ++i)
                                       {
-                                        const double vs = v_stage[i];
-                                        dx_sum[i] += 2.0 * vs;
-                                        dv_sum[i] += 2.0 * a_stage[i];
-                                        x_stage[i] = x[i] + to_next * vs;
-                                        v_stage[i] = v[i] + to_next * a_stage[i];
+                                        dx[i] = v[i];
+                                        dv[i] = a[i];
+                                        x0[i] = x[i] + half * v[i];
+                                        v0[i] = v[i] + half * a[i];
                                       }
                                     });
-        }
+        // Stages 2 and 3 (weights 2), at the midpoint, to the midpoint and to the end.
+        const auto middle_stage =
+          [&](const double *xs, const double *vs, double *x_to, double *v_to, double to)
+        {
+          system.compute_acceleration(
+            xs,
+            vs,
+            a,
+            [=](const unsigned int begin, const unsigned int end)
+            {
+              for (std::size_t i = 3 * std::size_t(begin); i < 3 * std::size_t(end); ++i)
+              {
+                dx[i] += 2.0 * vs[i];
+                dv[i] += 2.0 * a[i];
+                x_to[i] = x[i] + to * vs[i];
+                v_to[i] = v[i] + to * a[i];
+              }
+            });
+        };
+        middle_stage(x0, v0, x1, v1, half);
+        middle_stage(x1, v1, x0, v0, dt);
         // Stage 4 at the end of the step.
-        system.compute_acceleration(x_stage.data(), v_stage.data(), a_stage.data());
-        const double sixth = dt / 6.0;
-        for_each_coordinate_range(system,
-                                  [&](const std::size_t begin, const std::size_t end)
-                                  {
-                                    for (std::size_t i = begin; i < end; ++i)
+        system.compute_acceleration(x0,
+                                    v0,
+                                    a,
+                                    [=](const unsigned int begin, const unsigned int end)
                                     {
-                                      x[i] += sixth * (dx_sum[i] + v_stage[i]);
-                                      v[i] += sixth * (dv_sum[i] + a_stage[i]);
-                                    }
-                                  });
+                                      for (std::size_t i = 3 * std::size_t(begin);
+                                           i < 3 * std::size_t(end);
+                                           ++i)
+                                      {
+                                        x[i] += sixth * (dx[i] + v0[i]);
+                                        v[i] += sixth * (dv[i] + a[i]);
+                                      }
+                                    });
         system.enforce_constraints(t + dt, x, v);
       }
 
@@ -114,7 +135,12 @@ namespace lacerta::physics
       }
 
     private:
-      std::vector<double> x_stage, v_stage, a_stage, dx_sum, dv_sum;
+      /// Two stage states (positions and velocities): a stage reads one, writes the
+      /// other.
+      std::array<std::vector<double>, 2> x_stage, v_stage;
+
+      /// The stage's accelerations and the weighted sums of the stages' slopes.
+      std::vector<double> a_stage, dx_sum, dv_sum;
     };
   } // namespace
 

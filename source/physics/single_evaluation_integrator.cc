@@ -19,6 +19,22 @@ namespace lacerta::physics
   }
 
 
+  void
+  SingleEvaluationIntegrator::prepare_next_state(const ParticleSystem &system)
+  {
+    resize_like(next_position, system.position);
+    resize_like(next_velocity, system.velocity);
+  }
+
+
+  void
+  SingleEvaluationIntegrator::take_next_state(ParticleSystem &system)
+  {
+    system.position.swap(next_position);
+    system.velocity.swap(next_velocity);
+  }
+
+
   unsigned int
   SingleEvaluationIntegrator::n_evaluations_per_step() const
   {

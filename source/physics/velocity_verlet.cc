@@ -50,14 +50,23 @@ namespace lacerta::physics
                                   });
         // Constrained particles must be in place before the new forces are computed.
         system.enforce_constraints(t + dt, x, v);
-        system.compute_acceleration(x, v, acceleration.data());
-        for_each_coordinate_range(system,
-                                  [&](const std::size_t begin, const std::size_t end)
-                                  {
-                                    for (std::size_t i = begin; i < end; ++i)
-                                      v[i] += 0.5 * dt * acceleration[i];
-                                  });
-        system.enforce_constraints(t + dt, x, v);
+        // Each thread kicks its particles as soon as their accelerations are known,
+        // into the next velocities: the other threads may still read these.
+        resize_like(next_velocity, system.velocity);
+        const double *a      = acceleration.data();
+        double       *v_next = next_velocity.data();
+        system.compute_acceleration(x,
+                                    v,
+                                    acceleration.data(),
+                                    [=](const unsigned int begin, const unsigned int end)
+                                    {
+                                      for (std::size_t i = 3 * std::size_t(begin);
+                                           i < 3 * std::size_t(end);
+                                           ++i)
+                                        v_next[i] = v[i] + 0.5 * dt * a[i];
+                                    });
+        system.velocity.swap(next_velocity);
+        system.enforce_constraints(t + dt, x, system.velocity.data());
         acceleration_is_current = true;
       }
 

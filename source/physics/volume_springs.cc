@@ -147,7 +147,8 @@ namespace lacerta::physics
       compute_acceleration(const ParticleSystem &system,
                            const double         *x,
                            const double         *v,
-                           double               *a) const override
+                           double               *a,
+                           const RangeUpdate     update) const override
       {
         ranges.for_each_part(
           [&](const unsigned int p)
@@ -155,6 +156,7 @@ namespace lacerta::physics
             spring_forces_of_part(system, p, x, v, a);
             add_element_forces(system, p, x, v, a);
             ranges.finish_accelerations(system, p, v, a);
+            update(ranges.begin(p), ranges.end(p));
           });
       }
 
@@ -170,6 +172,7 @@ namespace lacerta::physics
             spring_forces_of_part(system, p, x, v, f);
             add_element_forces(system, p, x, v, f);
           });
+        add_held_spring_forces(system, x, v, f);
       }
 
       double

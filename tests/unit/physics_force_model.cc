@@ -75,6 +75,12 @@ namespace
     const mesh::TetMesh mesh   = test_support::distorted_box(8, 0.2, {1, 1, 1});
     auto                system = test_support::make_system(mesh, 1000, 1e4, n_threads);
     system->spring_damping     = 1e-3;
+    // A clamped slice, whose springs among themselves the model keeps apart: changes
+    // move springs into and out of that set too.
+    for (unsigned int i = 0; i < system->n_particles(); ++i)
+      if (system->position[3 * i] < 0.2)
+        system->free[i] = 0;
+    system->update_force_model(n_threads);
     std::mt19937 rng(5);
     for (unsigned int round = 0; round < 30; ++round)
     {
@@ -157,6 +163,44 @@ TEST(ForceModelLocalUpdate, RemovingEverySpringLeavesNoForce)
 }
 
 
+namespace
+{
+  /// Spring forces of every spring of @p system at (@p x, @p v), summed in the
+  /// springs' order: the spring law as the paper writes it, with no partition.
+  std::vector<double>
+  forces_of_every_spring(const physics::ParticleSystem &system,
+                         const std::vector<double>     &x,
+                         const std::vector<double>     &v)
+  {
+    std::vector<double>       f(x.size(), 0.0);
+    const physics::SpringSet &springs = system.springs;
+    const double              beta    = system.spring_damping;
+    for (std::size_t s = 0; s < springs.size(); ++s)
+    {
+      const std::size_t i = 3 * std::size_t(springs.a[s]),
+                        j = 3 * std::size_t(springs.b[s]);
+      const double dx = x[j] - x[i], dy = x[j + 1] - x[i + 1], dz = x[j + 2] - x[i + 2];
+      const double len       = std::sqrt(dx * dx + dy * dy + dz * dz);
+      const double inv       = 1.0 / len;
+      const double k         = springs.stiffness[s];
+      double       magnitude = k * (len - springs.rest_length[s]);
+      if (beta > 0)
+        magnitude += beta * k * inv
+                     * ((v[j] - v[i]) * dx + (v[j + 1] - v[i + 1]) * dy
+                        + (v[j + 2] - v[i + 2]) * dz);
+      const double scale = magnitude * inv;
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        const double component = scale * (d == 0 ? dx : d == 1 ? dy : dz);
+        f[i + d] += component;
+        f[j + d] -= component;
+      }
+    }
+    return f;
+  }
+} // namespace
+
+
 TEST(LinearSprings, LargeRangesGiveTheSpringLawToTheLastBit)
 {
   // 34³ = 39,304 particles: on one thread the range is large enough for the loop to
@@ -176,30 +220,89 @@ TEST(LinearSprings, LargeRangesGiveTheSpringLawToTheLastBit)
   for (const double beta : {0.0, 1e-3})
   {
     system->spring_damping = beta;
-    std::vector<double> mine(x.size()), expected(x.size(), 0.0);
+    std::vector<double> mine(x.size());
     system->force_model().compute_spring_forces(*system, x.data(), v.data(), mine.data());
+    const std::vector<double> expected = forces_of_every_spring(*system, x, v);
+    EXPECT_EQ(mine, expected) << "damping " << beta;
+  }
+}
+
+
+TEST(LinearSprings, SpringsBetweenPrescribedParticlesActOnNoFreeParticle)
+{
+  // A box clamped over a third of its length, its springs stretched and moving: the
+  // accelerations skip the springs between two clamped particles, so the free
+  // particles' are those of every spring, to the last bit on one range (the skipped
+  // springs add nothing to a free particle's sum), and the clamped ones' are zero.
+  // The spring forces and the elastic energy still count every spring.
+  const mesh::TetMesh mesh = test_support::distorted_box(6, 0.2, {1, 1, 1});
+  for (const unsigned int n_threads : {1u, 3u})
+  {
+    auto system            = test_support::make_system(mesh, 1000, 1e4, n_threads);
+    system->spring_damping = 1e-3;
+    unsigned int clamped   = 0;
+    for (unsigned int i = 0; i < system->n_particles(); ++i)
+      if (system->position[3 * i] < 0.34)
+      {
+        system->free[i] = 0;
+        ++clamped;
+      }
+    system->update_force_model(n_threads);
+    ASSERT_GT(clamped, system->n_particles() / 4);
+
+    std::mt19937                           rng(11);
+    std::uniform_real_distribution<double> jitter(-0.02, 0.02);
+    std::vector<double>                    x(system->position), v(x.size());
+    for (std::size_t i = 0; i < x.size(); ++i)
+    {
+      x[i] += jitter(rng);
+      v[i] = 10 * jitter(rng);
+    }
+    const std::vector<double> expected = forces_of_every_spring(*system, x, v);
+
+    std::vector<double> a(x.size());
+    system->compute_acceleration(x.data(), v.data(), a.data());
+    double largest = 0, worst = 0;
+    for (unsigned int i = 0; i < system->n_particles(); ++i)
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        const std::size_t k = 3 * std::size_t(i) + d;
+        if (system->free[i] == 0)
+        {
+          EXPECT_EQ(a[k], 0.0) << "clamped particle " << i;
+          continue;
+        }
+        const double wanted = expected[k] * (1.0 / system->mass[i]);
+        largest             = std::max(largest, std::abs(wanted));
+        worst               = std::max(worst, std::abs(a[k] - wanted));
+        if (n_threads == 1)
+          EXPECT_EQ(a[k], wanted) << "free particle " << i;
+      }
+    EXPECT_LE(worst, 1e-12 * largest) << n_threads << " threads";
+
+    std::vector<double> f(x.size());
+    system->force_model().compute_spring_forces(*system, x.data(), v.data(), f.data());
+    double largest_force = 0, worst_force = 0;
+    for (std::size_t k = 0; k < f.size(); ++k)
+    {
+      largest_force = std::max(largest_force, std::abs(expected[k]));
+      worst_force   = std::max(worst_force, std::abs(f[k] - expected[k]));
+    }
+    EXPECT_LE(worst_force, 1e-12 * largest_force) << n_threads << " threads";
+
+    double                    energy  = 0;
     const physics::SpringSet &springs = system->springs;
     for (std::size_t s = 0; s < springs.size(); ++s)
     {
       const std::size_t i = 3 * std::size_t(springs.a[s]),
                         j = 3 * std::size_t(springs.b[s]);
-      const double dx = x[j] - x[i], dy = x[j + 1] - x[i + 1], dz = x[j + 2] - x[i + 2];
-      const double len       = std::sqrt(dx * dx + dy * dy + dz * dz);
-      const double inv       = 1.0 / len;
-      const double k         = springs.stiffness[s];
-      double       magnitude = k * (len - springs.rest_length[s]);
-      if (beta > 0)
-        magnitude += beta * k * inv
-                     * ((v[j] - v[i]) * dx + (v[j + 1] - v[i + 1]) * dy
-                        + (v[j + 2] - v[i + 2]) * dz);
-      const double scale = magnitude * inv;
-      expected[i] += scale * dx;
-      expected[i + 1] += scale * dy;
-      expected[i + 2] += scale * dz;
-      expected[j] -= scale * dx;
-      expected[j + 1] -= scale * dy;
-      expected[j + 2] -= scale * dz;
+      const double length =
+        std::hypot(x[j] - x[i], x[j + 1] - x[i + 1], x[j + 2] - x[i + 2]);
+      energy += 0.5 * springs.stiffness[s] * std::pow(length - springs.rest_length[s], 2);
     }
-    EXPECT_EQ(mine, expected) << "damping " << beta;
+    EXPECT_NEAR(system->force_model().elastic_energy(*system, x.data()),
+                energy,
+                1e-12 * energy)
+      << n_threads << " threads";
   }
 }

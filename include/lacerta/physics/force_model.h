@@ -5,6 +5,7 @@
 #pragma once
 
 #include <lacerta/base/plugins.h>
+#include <lacerta/physics/range_update.h>
 
 #include <array>
 #include <functional>
@@ -74,13 +75,23 @@ namespace lacerta::physics
 
     /**
      * Accelerations: spring forces plus the system's loads and particle damping,
-     * divided by the masses, zero for constrained particles.
+     * divided by the masses, zero for constrained particles. Then @p update runs for
+     * every thread range's particles, on that range's thread, as soon as their
+     * accelerations are complete (see RangeUpdate).
      */
     virtual void
     compute_acceleration(const ParticleSystem &system,
                          const double         *x,
                          const double         *v,
-                         double               *a) const = 0;
+                         double               *a,
+                         RangeUpdate           update) const = 0;
+
+    /// Accelerations, as above, with no update.
+    void
+    compute_acceleration(const ParticleSystem &system,
+                         const double         *x,
+                         const double         *v,
+                         double               *a) const;
 
     /// Spring forces (including damping along springs) on every particle.
     virtual void

@@ -8,6 +8,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace lacerta
 {
@@ -108,6 +109,15 @@ namespace lacerta::physics
    */
   double
   symplectic_critical_time_step(double omega, double c);
+
+  /**
+   * Gives @p buffer the size of @p state and at least its capacity, so that an
+   * integrator that writes the next state into @p buffer and swaps the two keeps the
+   * state's room to grow (ParticleSystem::reserve()): a cut that adds particles then
+   * copies no array of the whole system.
+   */
+  void
+  resize_like(std::vector<double> &buffer, const std::vector<double> &state);
 } // namespace lacerta::physics
 
 /// Registers an integrator plugin, e.g. LACERTA_REGISTER_INTEGRATOR(Rk4, "rk4", "...").

@@ -34,6 +34,13 @@ namespace lacerta::physics
    * would: on one range the forces are those of initialize() to the last bit. New
    * particles join the last range; when the ranges' loads drift apart by more than a
    * quarter of the mean, the partition is made again.
+   *
+   * A spring between two particles whose motion is prescribed (ParticleSystem::free)
+   * acts on no free particle: it is kept apart, in a segment of its own that the
+   * accelerations skip, and only the spring forces and the elastic energy count it.
+   * Clamped regions thus cost nothing per step, however finely they are meshed. The
+   * particles' constraints must be set before their springs are placed (initialize()
+   * and springs_changed() read them).
    */
   class LinearSprings : public ForceModel
   {
@@ -57,7 +64,10 @@ namespace lacerta::physics
     compute_acceleration(const ParticleSystem &system,
                          const double         *x,
                          const double         *v,
-                         double               *a) const override;
+                         double               *a,
+                         RangeUpdate           update) const override;
+
+    using ForceModel::compute_acceleration;
 
     void
     compute_spring_forces(const ParticleSystem &system,
@@ -85,6 +95,16 @@ namespace lacerta::physics
                           const double         *x,
                           const double         *v,
                           double               *f) const;
+
+    /**
+     * Adds the forces of the springs between two prescribed particles, which the
+     * accelerations skip, to both ends in @p f.
+     */
+    void
+    add_held_spring_forces(const ParticleSystem &system,
+                           const double         *x,
+                           const double         *v,
+                           double               *f) const;
 
     /// Sets the factor applied to every spring's stiffness (before initialize()).
     void
@@ -158,7 +178,12 @@ namespace lacerta::physics
     bool
     unbalanced() const;
 
-    /// Inner and crossing springs of range p: segments 2p and 2p + 1.
+    /// The last segment: the springs between two prescribed particles.
+    unsigned int
+    held_segment() const;
+
+    /// Inner and crossing springs of range p: segments 2p and 2p + 1; the last
+    /// segment holds the springs between two prescribed particles.
     std::vector<Segment> segments;
     /// The segments that hold each system spring's copies.
     std::vector<Holders> holders;

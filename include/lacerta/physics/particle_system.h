@@ -4,6 +4,7 @@
  */
 #pragma once
 
+#include <lacerta/physics/range_update.h>
 #include <lacerta/physics/spring_set.h>
 
 #include <array>
@@ -229,6 +230,16 @@ namespace lacerta::physics
      */
     void
     compute_acceleration(const double *x, const double *v, double *a) const;
+
+    /**
+     * Accelerations, as above, and @p update of every thread range's particles in the
+     * same parallel pass (see RangeUpdate).
+     */
+    void
+    compute_acceleration(const double *x,
+                         const double *v,
+                         double       *a,
+                         RangeUpdate   update) const;
 
     /// Kinetic energy ½ Σ m |v|² of the current state.
     double

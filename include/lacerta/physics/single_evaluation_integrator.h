@@ -5,7 +5,9 @@
 #pragma once
 
 #include <lacerta/physics/integrator.h>
+#include <lacerta/physics/particle_system.h>
 
+#include <cstddef>
 #include <vector>
 
 namespace lacerta::physics
@@ -34,7 +36,49 @@ namespace lacerta::physics
     serialize(Archive &archive) override;
 
   protected:
+    /**
+     * Evaluates the accelerations at the system's state and, in the same parallel
+     * pass, writes every coordinate's next position and velocity with
+     * @p update(x, v, a, x_next, v_next); then makes the next state the system's and
+     * enforces the constraints at @p t + @p dt.
+     */
+    template <typename Update>
+    void
+    advance(ParticleSystem &system, const double t, const double dt, const Update &update)
+    {
+      prepare_next_state(system);
+      const double *x = system.position.data(), *v = system.velocity.data();
+      const double *a      = acceleration.data();
+      double       *x_next = next_position.data(), *v_next = next_velocity.data();
+      system.compute_acceleration(
+        x,
+        v,
+        acceleration.data(),
+        [=, &update](const unsigned int begin, const unsigned int end)
+        {
+          for (std::size_t i = 3 * std::size_t(begin); i < 3 * std::size_t(end); ++i)
+            update(x[i], v[i], a[i], x_next[i], v_next[i]);
+        });
+      take_next_state(system);
+      system.enforce_constraints(t + dt, system.position.data(), system.velocity.data());
+    }
+
+    /**
+     * Sizes the next state's buffers like the system's positions and velocities, for
+     * an update that writes the next state while other threads may still read the
+     * current one (see RangeUpdate).
+     */
+    void
+    prepare_next_state(const ParticleSystem &system);
+
+    /// Makes the next state the system's positions and velocities (a swap, no copy).
+    void
+    take_next_state(ParticleSystem &system);
+
     /// Accelerations of the current evaluation, 3 per particle.
     std::vector<double> acceleration;
+
+    /// The next positions and velocities, 3 per particle (scratch of one step).
+    std::vector<double> next_position, next_velocity;
   };
 } // namespace lacerta::physics
