@@ -24,10 +24,9 @@ namespace lacerta::bench
     for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
       for (unsigned int d = 0; d < 3; ++d)
         rest[3 * v + d] = mesh.vertex(v)[d];
-    auto system                 = std::make_unique<physics::ParticleSystem>(rest);
-    system->mass                = physics::compute_masses(mesh, density);
-    system->springs             = physics::compute_springs(mesh, youngs);
-    system->enforce_constraints = [](double, double *, double *) {};
+    auto system     = std::make_unique<physics::ParticleSystem>(rest);
+    system->mass    = physics::compute_masses(mesh, density);
+    system->springs = physics::compute_springs(mesh, youngs);
     system->set_force_model(physics::ForceModelRegistry::create("linear springs"), 1);
     return system;
   }

@@ -201,6 +201,14 @@ namespace lacerta::physics
   }
 
 
+  void
+  ParticleSystem::enforce_constraints(const double t, double *x, double *v) const
+  {
+    prepare_constraints(t);
+    prescribe_constraints(x, v, 0, n_particles());
+  }
+
+
   double
   ParticleSystem::kinetic_energy() const
   {

@@ -91,21 +91,22 @@ namespace lacerta::physics
         };
         middle_stage(x0, v0, x1, v1, half);
         middle_stage(x1, v1, x0, v0, dt);
-        // Stage 4 at the end of the step.
-        system.compute_acceleration(x0,
-                                    v0,
-                                    a,
-                                    [=](const unsigned int begin, const unsigned int end)
-                                    {
-                                      for (std::size_t i = 3 * std::size_t(begin);
-                                           i < 3 * std::size_t(end);
-                                           ++i)
-                                      {
-                                        x[i] += sixth * (dx[i] + v0[i]);
-                                        v[i] += sixth * (dv[i] + a[i]);
-                                      }
-                                    });
-        system.enforce_constraints(t + dt, x, v);
+        // Stage 4 at the end of the step, which puts the range's constrained particles
+        // where the scene prescribes them.
+        system.prepare_constraints(t + dt);
+        system.compute_acceleration(
+          x0,
+          v0,
+          a,
+          [=, &system](const unsigned int begin, const unsigned int end)
+          {
+            for (std::size_t i = 3 * std::size_t(begin); i < 3 * std::size_t(end); ++i)
+            {
+              x[i] += sixth * (dx[i] + v0[i]);
+              v[i] += sixth * (dv[i] + a[i]);
+            }
+            system.prescribe_constraints(x, v, begin, end);
+          });
       }
 
       double

@@ -69,7 +69,17 @@ namespace lacerta::scene
 
 
   void
-  Constraint::prescribe(double, const double *, double *, double *) const
+  Constraint::prepare(double, const double *)
+  {
+  }
+
+
+  void
+  Constraint::prescribe(const double *,
+                        double *,
+                        double *,
+                        const unsigned int,
+                        const unsigned int) const
   {
   }
 

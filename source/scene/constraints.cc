@@ -38,14 +38,19 @@ namespace lacerta::scene
       }
 
       void
-      prescribe(double, const double *rest, double *x, double *v) const override
+      prescribe(const double      *rest,
+                double            *x,
+                double            *v,
+                const unsigned int begin,
+                const unsigned int end) const override
       {
         for (const unsigned int i : particles)
-          for (unsigned int d = 0; d < 3; ++d)
-          {
-            x[3 * i + d] = rest[3 * i + d];
-            v[3 * i + d] = 0.0;
-          }
+          if (i >= begin && i < end)
+            for (unsigned int d = 0; d < 3; ++d)
+            {
+              x[3 * i + d] = rest[3 * i + d];
+              v[3 * i + d] = 0.0;
+            }
       }
     };
 
@@ -86,45 +91,66 @@ namespace lacerta::scene
       }
 
       void
-      prescribe(const double t, const double *rest, double *x, double *v) const override
+      prepare(const double t, const double *rest) override
       {
         // One time level at a time: FunctionParser::set_time is not free, and this runs
         // at every step for every particle of the handle. A displacement that names
         // none of x, y and z is the same for every particle: evaluated once (each
         // evaluation of the parser looks its thread's copy up under a lock).
-        const double h                  = 1e-7 * std::max(1.0, std::abs(t));
-        const auto   for_each_component = [&](const double time, const auto &use)
+        const double      h                  = 1e-7 * std::max(1.0, std::abs(t));
+        const std::size_t n                  = rigid_translation ? 1 : particles.size();
+        const auto        for_each_component = [&](const double time, const auto &use)
         {
           displacement->set_time(time);
-          std::array<double, 3> u{};
-          const auto            evaluate = [&](const dealii::Point<3> &p)
+          for (std::size_t k = 0; k < n; ++k)
           {
+            const unsigned int     i = particles[k];
+            const dealii::Point<3> p =
+              rigid_translation
+                ? dealii::Point<3>()
+                : dealii::Point<3>(rest[3 * i], rest[3 * i + 1], rest[3 * i + 2]);
             for (unsigned int d = 0; d < 3; ++d)
-              u[d] = displacement->value(p, d);
-          };
-          if (rigid_translation)
-            evaluate(dealii::Point<3>());
-          for (const unsigned int i : particles)
-          {
-            if (!rigid_translation)
-              evaluate(dealii::Point<3>(rest[3 * i], rest[3 * i + 1], rest[3 * i + 2]));
-            for (unsigned int d = 0; d < 3; ++d)
-              use(3 * i + d, u[d]);
+              use(3 * k + d, displacement->value(p, d));
           }
         };
+        offset.resize(3 * n);
+        velocity.resize(3 * n);
         for_each_component(t,
-                           [&](const unsigned int c, const double u)
-                           { x[c] = rest[c] + u; });
-        // Central difference: v holds u(t + h) until u(t - h) is known.
+                           [&](const std::size_t c, const double u) { offset[c] = u; });
+        // Central difference: the velocity holds u(t + h) until u(t - h) is known.
         for_each_component(t + h,
-                           [&](const unsigned int c, const double u) { v[c] = u; });
+                           [&](const std::size_t c, const double u) { velocity[c] = u; });
         for_each_component(t - h,
-                           [&](const unsigned int c, const double u)
-                           { v[c] = (v[c] - u) / (2 * h); });
+                           [&](const std::size_t c, const double u)
+                           { velocity[c] = (velocity[c] - u) / (2 * h); });
+      }
+
+      void
+      prescribe(const double      *rest,
+                double            *x,
+                double            *v,
+                const unsigned int begin,
+                const unsigned int end) const override
+      {
+        for (std::size_t k = 0; k < particles.size(); ++k)
+        {
+          const unsigned int i = particles[k];
+          if (i < begin || i >= end)
+            continue;
+          const std::size_t from = rigid_translation ? 0 : 3 * k;
+          for (unsigned int d = 0; d < 3; ++d)
+          {
+            x[3 * i + d] = rest[3 * i + d] + offset[from + d];
+            v[3 * i + d] = velocity[from + d];
+          }
+        }
       }
 
     private:
       std::unique_ptr<dealii::FunctionParser<3>> displacement;
+      /// The displacement and velocity prepare() evaluated, 3 per particle (one
+      /// particle's for a rigid translation).
+      std::vector<double> offset, velocity;
       /// Whether the displacement names none of x, y and z.
       bool rigid_translation = false;
     };

@@ -329,10 +329,16 @@ namespace lacerta::scene
       constraint->initialize(&active == &mesh ? constraint->particles
                                               : constraint->region->select(active),
                              *system);
-    system->enforce_constraints = [this](const double time, double *x, double *v)
+    system->prepare_constraints = [this](const double time)
     {
       for (const auto &constraint : constraints)
-        constraint->prescribe(time, system->rest_position().data(), x, v);
+        constraint->prepare(time, system->rest_position().data());
+    };
+    system->prescribe_constraints =
+      [this](double *x, double *v, const unsigned int begin, const unsigned int end)
+    {
+      for (const auto &constraint : constraints)
+        constraint->prescribe(system->rest_position().data(), x, v, begin, end);
     };
     system->enforce_constraints(t, system->position.data(), system->velocity.data());
     update_loads(t);

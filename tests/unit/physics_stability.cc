@@ -265,13 +265,17 @@ TEST(Stability, MonitorAcceptsAStableDampedRunWithWorkInput)
       if (system->position[3 * i] > 0.05)
         pulled.push_back(i);
     }
-  system->enforce_constraints = [&](const double t, double *x, double *v)
+  double prescribed_time      = 0;
+  system->prepare_constraints = [&](const double t) { prescribed_time = t; };
+  system->prescribe_constraints =
+    [&](double *x, double *v, const unsigned int begin, const unsigned int end)
   {
     for (const unsigned int i : pulled)
-    {
-      x[3 * i] = system->rest_position()[3 * i] + 0.01 * t;
-      v[3 * i] = 0.01;
-    }
+      if (i >= begin && i < end)
+      {
+        x[3 * i] = system->rest_position()[3 * i] + 0.01 * prescribed_time;
+        v[3 * i] = 0.01;
+      }
   };
   const auto integrator = physics::IntegratorRegistry::create("velocity_verlet");
   integrator->initialize(*system);
@@ -419,7 +423,6 @@ TEST(Stability, MultirateShareCountsEachSpringAtItsOwnStep)
   system.mass = {1, 1, 4, 4, 16, 16};
   for (unsigned int s = 0; s < 3; ++s)
     system.springs.push_back(2 * s, 2 * s + 1, 100, 0.1);
-  system.enforce_constraints = [](double, double *, double *) {};
   system.set_force_model(physics::ForceModelRegistry::create("linear springs"), 1);
 
   const std::vector<double> omega = physics::particle_frequency_bounds(system);

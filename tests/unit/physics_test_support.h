@@ -65,10 +65,9 @@ namespace lacerta::test_support
       physics::compute_masses(mesh, dealii::Functions::ConstantFunction<3>(density));
     system->springs =
       physics::compute_springs(mesh, dealii::Functions::ConstantFunction<3>(youngs));
-    system->enforce_constraints = [](double, double *, double *) {};
-    system->mesh                = &mesh;
-    system->youngs_modulus      = &moduli.back();
-    system->poisson_ratio       = poisson_ratio;
+    system->mesh           = &mesh;
+    system->youngs_modulus = &moduli.back();
+    system->poisson_ratio  = poisson_ratio;
     system->set_force_model(physics::ForceModelRegistry::create(model), n_threads);
     return system;
   }

@@ -92,10 +92,17 @@ namespace lacerta::physics
     std::vector<std::array<double, 6>> cell_stiffness;
 
     /**
-     * Called by the integrators at the end of every (sub)step to put the constrained
-     * particles where the scene prescribes them at time t: (t, positions, velocities).
+     * How the scene prescribes the constrained particles' motion, in two parts:
+     * `prepare_constraints(t)` readies the motion at time t, then
+     * `prescribe_constraints(x, v, begin, end)` writes it into the positions x and
+     * velocities v of the constrained particles in [begin, end), and no other entry,
+     * so that every thread's range of particles can do it in parallel (an
+     * integrator's RangeUpdate). Both do nothing unless the scene sets them.
      */
-    std::function<void(double, double *, double *)> enforce_constraints;
+    std::function<void(double)> prepare_constraints = [](double) {};
+    /// See prepare_constraints.
+    std::function<void(double *, double *, unsigned int, unsigned int)>
+      prescribe_constraints = [](double *, double *, unsigned int, unsigned int) {};
 
     /// Wall time spent in compute_acceleration() since it was last reset (s).
     mutable double force_seconds = 0;
@@ -240,6 +247,14 @@ namespace lacerta::physics
                          const double *v,
                          double       *a,
                          RangeUpdate   update) const;
+
+    /**
+     * Puts every constrained particle where the scene prescribes it at time @p t, in
+     * the positions @p x and velocities @p v (prepare_constraints, then
+     * prescribe_constraints over all particles).
+     */
+    void
+    enforce_constraints(double t, double *x, double *v) const;
 
     /// Kinetic energy ½ Σ m |v|² of the current state.
     double

@@ -39,14 +39,16 @@ namespace lacerta::physics
     /**
      * Evaluates the accelerations at the system's state and, in the same parallel
      * pass, writes every coordinate's next position and velocity with
-     * @p update(x, v, a, x_next, v_next); then makes the next state the system's and
-     * enforces the constraints at @p t + @p dt.
+     * @p update(x, v, a, x_next, v_next) and puts the range's constrained particles
+     * where the scene prescribes them at @p t + @p dt; then makes the next state the
+     * system's.
      */
     template <typename Update>
     void
     advance(ParticleSystem &system, const double t, const double dt, const Update &update)
     {
       prepare_next_state(system);
+      system.prepare_constraints(t + dt);
       const double *x = system.position.data(), *v = system.velocity.data();
       const double *a      = acceleration.data();
       double       *x_next = next_position.data(), *v_next = next_velocity.data();
@@ -54,13 +56,13 @@ namespace lacerta::physics
         x,
         v,
         acceleration.data(),
-        [=, &update](const unsigned int begin, const unsigned int end)
+        [=, &update, &system](const unsigned int begin, const unsigned int end)
         {
           for (std::size_t i = 3 * std::size_t(begin); i < 3 * std::size_t(end); ++i)
             update(x[i], v[i], a[i], x_next[i], v_next[i]);
+          system.prescribe_constraints(x_next, v_next, begin, end);
         });
       take_next_state(system);
-      system.enforce_constraints(t + dt, system.position.data(), system.velocity.data());
     }
 
     /**

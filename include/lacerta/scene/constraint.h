@@ -83,11 +83,25 @@ namespace lacerta::scene
     prescribes_motion() const = 0;
 
     /**
-     * Writes the prescribed positions and velocities at time @p t into @p x and @p v
-     * (3 values per particle), given the rest positions @p rest.
+     * Readies the motion prescribed at time @p t for prescribe() (what the motion's
+     * expression gives, evaluated once per time level), given the rest positions
+     * @p rest. Nothing by default.
      */
     virtual void
-    prescribe(double t, const double *rest, double *x, double *v) const;
+    prepare(double t, const double *rest);
+
+    /**
+     * Writes the positions and velocities prepare() readied into @p x and @p v (3
+     * values per particle) for the constraint's particles in [@p begin, @p end),
+     * given the rest positions @p rest, and no other entry: the threads' ranges of
+     * particles call it in parallel. Nothing by default.
+     */
+    virtual void
+    prescribe(const double *rest,
+              double       *x,
+              double       *v,
+              unsigned int  begin,
+              unsigned int  end) const;
 
     /// Adds the forces the constraint applies at time @p t to the system's external
     /// forces.
