@@ -276,22 +276,6 @@ namespace lacerta::physics
   {
     ranges.for_each_part([&](const unsigned int p)
                          { spring_forces_of_part(system, p, x, v, f); });
-    add_held_spring_forces(system, x, v, f);
-  }
-
-
-  void
-  LinearSprings::add_held_spring_forces(const ParticleSystem &system,
-                                        const double         *x,
-                                        const double         *v,
-                                        double               *f) const
-  {
-    const SpringSet &held = segments.back().set;
-    if (system.spring_damping > 0)
-      add_spring_forces<true, true, false>(
-        held, 0, held.size(), x, v, system.spring_damping, f);
-    else
-      add_spring_forces<false, true, false>(held, 0, held.size(), x, v, 0.0, f);
   }
 
 
@@ -315,7 +299,7 @@ namespace lacerta::physics
         part_energy[p] = energy_of(segments[2 * p].set, x, 1.0)
                          + energy_of(segments[2 * p + 1].set, x, 0.5);
       });
-    double energy = energy_of(segments.back().set, x, 1.0);
+    double energy = 0;
     for (const double e : part_energy)
       energy += e;
     return energy;

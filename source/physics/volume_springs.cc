@@ -172,7 +172,6 @@ namespace lacerta::physics
             spring_forces_of_part(system, p, x, v, f);
             add_element_forces(system, p, x, v, f);
           });
-        add_held_spring_forces(system, x, v, f);
       }
 
       double

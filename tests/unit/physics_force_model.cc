@@ -165,16 +165,15 @@ TEST(ForceModelLocalUpdate, RemovingEverySpringLeavesNoForce)
 
 namespace
 {
-  /// Spring forces of every spring of @p system at (@p x, @p v), summed in the
+  /// Spring forces of @p springs (with damping @p beta) at (@p x, @p v), summed in the
   /// springs' order: the spring law as the paper writes it, with no partition.
   std::vector<double>
-  forces_of_every_spring(const physics::ParticleSystem &system,
-                         const std::vector<double>     &x,
-                         const std::vector<double>     &v)
+  forces_of_springs(const physics::SpringSet  &springs,
+                    const double               beta,
+                    const std::vector<double> &x,
+                    const std::vector<double> &v)
   {
-    std::vector<double>       f(x.size(), 0.0);
-    const physics::SpringSet &springs = system.springs;
-    const double              beta    = system.spring_damping;
+    std::vector<double> f(x.size(), 0.0);
     for (std::size_t s = 0; s < springs.size(); ++s)
     {
       const std::size_t i = 3 * std::size_t(springs.a[s]),
@@ -222,7 +221,8 @@ TEST(LinearSprings, LargeRangesGiveTheSpringLawToTheLastBit)
     system->spring_damping = beta;
     std::vector<double> mine(x.size());
     system->force_model().compute_spring_forces(*system, x.data(), v.data(), mine.data());
-    const std::vector<double> expected = forces_of_every_spring(*system, x, v);
+    const std::vector<double> expected =
+      forces_of_springs(system->springs, system->spring_damping, x, v);
     EXPECT_EQ(mine, expected) << "damping " << beta;
   }
 }
@@ -231,10 +231,11 @@ TEST(LinearSprings, LargeRangesGiveTheSpringLawToTheLastBit)
 TEST(LinearSprings, SpringsBetweenPrescribedParticlesActOnNoFreeParticle)
 {
   // A box clamped over a third of its length, its springs stretched and moving: the
-  // accelerations skip the springs between two clamped particles, so the free
-  // particles' are those of every spring, to the last bit on one range (the skipped
-  // springs add nothing to a free particle's sum), and the clamped ones' are zero.
-  // The spring forces and the elastic energy still count every spring.
+  // model leaves out the springs between two clamped particles, so the free
+  // particles' accelerations are those of every spring, to the last bit on one range
+  // (the skipped springs add nothing to a free particle's sum), and the clamped ones'
+  // are zero. The spring forces and the elastic energy are those of the other springs:
+  // on a clamped particle, the reaction of the free material.
   const mesh::TetMesh mesh = test_support::distorted_box(6, 0.2, {1, 1, 1});
   for (const unsigned int n_threads : {1u, 3u})
   {
@@ -258,7 +259,20 @@ TEST(LinearSprings, SpringsBetweenPrescribedParticlesActOnNoFreeParticle)
       x[i] += jitter(rng);
       v[i] = 10 * jitter(rng);
     }
-    const std::vector<double> expected = forces_of_every_spring(*system, x, v);
+    // The springs with a free end, and the forces of every spring and of those.
+    physics::SpringSet        acting;
+    const physics::SpringSet &springs = system->springs;
+    for (std::size_t s = 0; s < springs.size(); ++s)
+      if (system->free[springs.a[s]] > 0 || system->free[springs.b[s]] > 0)
+        acting.push_back(springs.a[s],
+                         springs.b[s],
+                         springs.stiffness[s],
+                         springs.rest_length[s]);
+    ASSERT_LT(acting.size(), springs.size());
+    const std::vector<double> expected =
+      forces_of_springs(springs, system->spring_damping, x, v);
+    const std::vector<double> reactions =
+      forces_of_springs(acting, system->spring_damping, x, v);
 
     std::vector<double> a(x.size());
     system->compute_acceleration(x.data(), v.data(), a.data());
@@ -285,20 +299,19 @@ TEST(LinearSprings, SpringsBetweenPrescribedParticlesActOnNoFreeParticle)
     double largest_force = 0, worst_force = 0;
     for (std::size_t k = 0; k < f.size(); ++k)
     {
-      largest_force = std::max(largest_force, std::abs(expected[k]));
-      worst_force   = std::max(worst_force, std::abs(f[k] - expected[k]));
+      largest_force = std::max(largest_force, std::abs(reactions[k]));
+      worst_force   = std::max(worst_force, std::abs(f[k] - reactions[k]));
     }
     EXPECT_LE(worst_force, 1e-12 * largest_force) << n_threads << " threads";
 
-    double                    energy  = 0;
-    const physics::SpringSet &springs = system->springs;
-    for (std::size_t s = 0; s < springs.size(); ++s)
+    double energy = 0;
+    for (std::size_t s = 0; s < acting.size(); ++s)
     {
-      const std::size_t i = 3 * std::size_t(springs.a[s]),
-                        j = 3 * std::size_t(springs.b[s]);
+      const std::size_t i = 3 * std::size_t(acting.a[s]),
+                        j = 3 * std::size_t(acting.b[s]);
       const double length =
         std::hypot(x[j] - x[i], x[j + 1] - x[i + 1], x[j + 2] - x[i + 2]);
-      energy += 0.5 * springs.stiffness[s] * std::pow(length - springs.rest_length[s], 2);
+      energy += 0.5 * acting.stiffness[s] * std::pow(length - acting.rest_length[s], 2);
     }
     EXPECT_NEAR(system->force_model().elastic_energy(*system, x.data()),
                 energy,

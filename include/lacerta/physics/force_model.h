@@ -93,14 +93,21 @@ namespace lacerta::physics
                          const double         *v,
                          double               *a) const;
 
-    /// Spring forces (including damping along springs) on every particle.
+    /**
+     * Spring forces (including damping along springs) on every particle. A model may
+     * leave out the springs (and elements) between prescribed particles only, which
+     * act on no free particle (as `linear springs` does): the forces on free
+     * particles are complete, and those on prescribed particles are the reactions of
+     * the free material.
+     */
     virtual void
     compute_spring_forces(const ParticleSystem &system,
                           const double         *x,
                           const double         *v,
                           double               *f) const = 0;
 
-    /// Elastic energy stored in the springs (and elements) at positions @p x.
+    /// Elastic energy stored in the springs (and elements) at positions @p x, but
+    /// for those compute_spring_forces() leaves out.
     virtual double
     elastic_energy(const ParticleSystem &system, const double *x) const = 0;
 

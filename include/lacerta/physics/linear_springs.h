@@ -36,11 +36,12 @@ namespace lacerta::physics
    * quarter of the mean, the partition is made again.
    *
    * A spring between two particles whose motion is prescribed (ParticleSystem::free)
-   * acts on no free particle: it is kept apart, in a segment of its own that the
-   * accelerations skip, and only the spring forces and the elastic energy count it.
-   * Clamped regions thus cost nothing per step, however finely they are meshed. The
-   * particles' constraints must be set before their springs are placed (initialize()
-   * and springs_changed() read them).
+   * acts on no free particle, and is not part of the dynamical system: it is kept
+   * apart, in a segment of its own that neither the forces nor the elastic energy
+   * count. Clamped regions thus cost nothing per step, however finely they are
+   * meshed. A particle's constraint must be set before its springs are placed
+   * (initialize() and springs_changed() read them); one set later leaves its springs
+   * counted, which changes nothing but the cost.
    */
   class LinearSprings : public ForceModel
   {
@@ -95,16 +96,6 @@ namespace lacerta::physics
                           const double         *x,
                           const double         *v,
                           double               *f) const;
-
-    /**
-     * Adds the forces of the springs between two prescribed particles, which the
-     * accelerations skip, to both ends in @p f.
-     */
-    void
-    add_held_spring_forces(const ParticleSystem &system,
-                           const double         *x,
-                           const double         *v,
-                           double               *f) const;
 
     /// Sets the factor applied to every spring's stiffness (before initialize()).
     void
