@@ -161,11 +161,12 @@ namespace lacerta::bench
       prm.parse_input(extra, "benchmark settings", "", true);
       prm.set("End time", std::to_string(end_time));
       prm.set("Test mode", "true");
-      // One directory per process: benchmarks run side by side must not share it.
-      prm.set("Output directory",
-              (std::filesystem::temp_directory_path()
-               / ("lacerta-bench-lod-" + std::to_string(::getpid())))
-                .string());
+      // One directory per process: benchmarks run side by side must not share it. It
+      // holds only the run's parameter file, removed after the run.
+      const std::filesystem::path directory =
+        std::filesystem::temp_directory_path()
+        / ("lacerta-bench-lod-" + std::to_string(::getpid()));
+      prm.set("Output directory", directory.string());
       prm.enter_subsection("Postprocess");
       prm.set("List of postprocessors", "");
       prm.leave_subsection();
@@ -208,6 +209,7 @@ namespace lacerta::bench
             run.vertices.push_back(v);
       }
       std::cout.rdbuf(saved);
+      std::filesystem::remove_all(directory);
       return run;
     }
 

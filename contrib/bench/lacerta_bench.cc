@@ -2,6 +2,7 @@
 
 #include "benchmark_registry.h"
 #include <cstdio>
+#include <exception>
 #include <iostream>
 
 namespace lacerta::bench
@@ -49,5 +50,15 @@ main(int argc, char **argv)
         << "  " << name << ": " << benchmark.description << "\n";
     return asked ? 0 : 1;
   }
-  return found->second.run(std::vector<std::string>(argv + 2, argv + argc));
+  try
+  {
+    return found->second.run(std::vector<std::string>(argv + 2, argv + argc));
+  }
+  catch (const std::exception &error)
+  {
+    // Bad input (a parameter file that cannot be read, a bad entry): the message,
+    // and a non-zero exit, not an abort.
+    std::cerr << "lacerta-bench " << command << ": " << error.what() << "\n";
+    return 1;
+  }
 }
