@@ -451,18 +451,10 @@ namespace lacerta::physics
   bool
   LinearSprings::unbalanced() const
   {
-    const std::size_t n_parts = ranges.n_parts();
-    if (n_parts == 1)
-      return false;
-    std::size_t total = 0, largest = 0;
-    for (std::size_t p = 0; p < n_parts; ++p)
-    {
-      const std::size_t load =
-        segments[2 * p].origin.size() + segments[2 * p + 1].origin.size();
-      total += load;
-      largest = std::max(largest, load);
-    }
-    return largest > 1.25 * total / n_parts + 256;
+    std::vector<std::size_t> loads(ranges.n_parts());
+    for (std::size_t p = 0; p < loads.size(); ++p)
+      loads[p] = segments[2 * p].origin.size() + segments[2 * p + 1].origin.size();
+    return ParticleRanges::unbalanced(loads);
   }
 
 

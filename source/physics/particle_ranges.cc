@@ -32,6 +32,21 @@ namespace lacerta::physics
   }
 
 
+  bool
+  ParticleRanges::unbalanced(const std::vector<std::size_t> &loads)
+  {
+    if (loads.size() <= 1)
+      return false;
+    std::size_t total = 0, largest = 0;
+    for (const std::size_t load : loads)
+    {
+      total += load;
+      largest = std::max(largest, load);
+    }
+    return largest > 1.1 * total / loads.size() + 256;
+  }
+
+
   unsigned int
   ParticleRanges::part_of(const unsigned int i) const
   {

@@ -108,16 +108,10 @@ namespace lacerta::physics
   bool
   PartitionedTets::unbalanced() const
   {
-    const std::size_t n_parts = parts.size();
-    if (n_parts <= 1)
-      return false;
-    std::size_t total = 0, largest = 0;
+    std::vector<std::size_t> loads;
     for (const Part &part : parts)
-    {
-      total += part.size();
-      largest = std::max(largest, part.size());
-    }
-    return largest > 1.25 * total / n_parts + 256;
+      loads.push_back(part.size());
+    return ParticleRanges::unbalanced(loads);
   }
 
 

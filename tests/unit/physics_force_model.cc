@@ -2,6 +2,7 @@
 // removed, moved, added and restiffened and particles appended, the model gives the
 // forces and accelerations of a model made afresh for the same system.
 #include <lacerta/physics/force_model.h>
+#include <lacerta/physics/particle_ranges.h>
 #include <lacerta/physics/particle_system.h>
 
 #include <gtest/gtest.h>
@@ -318,4 +319,18 @@ TEST(LinearSprings, SpringsBetweenPrescribedParticlesActOnNoFreeParticle)
                 1e-12 * energy)
       << n_threads << " threads";
   }
+}
+
+
+TEST(ParticleRanges, RangesAreSplitAgainWhenOneExceedsTheMeanByATenth)
+{
+  using physics::ParticleRanges;
+  EXPECT_FALSE(ParticleRanges::unbalanced({50000})) << "one range";
+  EXPECT_FALSE(ParticleRanges::unbalanced({10000, 10000})) << "equal loads";
+  // Mean 11,500: the limit is 1.1 · 11,500 + 256 = 12,906.
+  EXPECT_TRUE(ParticleRanges::unbalanced({10000, 13000}));
+  EXPECT_FALSE(ParticleRanges::unbalanced({10000, 12000}));
+  EXPECT_TRUE(ParticleRanges::unbalanced({10000, 10000, 14000}));
+  // A small system is not split again for a few springs.
+  EXPECT_FALSE(ParticleRanges::unbalanced({0, 300}));
 }

@@ -33,7 +33,7 @@ namespace lacerta::physics
    * sums every particle's forces in the order a model made afresh on the same ranges
    * would: on one range the forces are those of initialize() to the last bit. New
    * particles join the last range; when the ranges' loads drift apart by more than a
-   * quarter of the mean, the partition is made again.
+   * tenth of the mean, the partition is made again.
    *
    * A spring between two particles whose motion is prescribed (ParticleSystem::free)
    * acts on no free particle, and is not part of the dynamical system: it is kept
@@ -164,8 +164,8 @@ namespace lacerta::physics
     std::vector<std::vector<unsigned int>> pending_erase;
     std::vector<std::vector<PendingCopy>>  pending_insert;
 
-    /// Whether a range evaluates more than 1.25 times the mean number of spring
-    /// copies (plus a little, so that small systems are not re-partitioned).
+    /// Whether the ranges' numbers of spring copies are so uneven that the ranges
+    /// should be split again (ParticleRanges::unbalanced()).
     bool
     unbalanced() const;
 

@@ -100,6 +100,17 @@ namespace lacerta::physics
                          const double         *v,
                          double               *a) const;
 
+    /**
+     * Whether the ranges' loads @p loads (the work of each range, in any unit) are
+     * so uneven that the ranges should be split again: the largest exceeds the mean
+     * by more than a tenth (and by 256, so that a small system is not split again for
+     * a few springs). A step waits for the largest range, while a new split costs
+     * about one evaluation, amortised over the growth that unbalanced the ranges
+     * (appended particles join the last range).
+     */
+    static bool
+    unbalanced(const std::vector<std::size_t> &loads);
+
     /// Runs @p work(p) for every range, in parallel if there is more than one.
     template <typename Work>
     void
