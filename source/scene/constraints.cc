@@ -104,11 +104,13 @@ namespace lacerta::scene
           displacement->set_time(time);
           for (std::size_t k = 0; k < n; ++k)
           {
-            const unsigned int     i = particles[k];
-            const dealii::Point<3> p =
-              rigid_translation
-                ? dealii::Point<3>()
-                : dealii::Point<3>(rest[3 * i], rest[3 * i + 1], rest[3 * i + 2]);
+            // A rigid translation reads no particle (the handle may have none left).
+            dealii::Point<3> p;
+            if (!rigid_translation)
+            {
+              const unsigned int i = particles[k];
+              p = dealii::Point<3>(rest[3 * i], rest[3 * i + 1], rest[3 * i + 2]);
+            }
             for (unsigned int d = 0; d < 3; ++d)
               use(3 * k + d, displacement->value(p, d));
           }
