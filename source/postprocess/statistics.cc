@@ -97,7 +97,8 @@ namespace lacerta::postprocess
     "statistics",
     "statistics.csv with one row per step: time, time step, "
     "sub-steps, kinetic, elastic and body-force energy, work of "
-    "the loads, wall time of force evaluation and of the step, and the "
+    "the loads, wall time of force evaluation (with the integrator's update "
+    "and the constraints done in the same parallel pass) and of the step, and the "
     "paper's Table 1 columns: mesh size, tetrahedra cut and created, mesh "
     "update wall time (ms); and the laceration columns: surface springs past "
     "their limit, tears, tetrahedra torn and created, tear wall time (ms); and the "

@@ -16,6 +16,7 @@ namespace lacerta::scene
                          physics::ParticleSystem         &system)
   {
     particles = selected;
+    std::sort(particles.begin(), particles.end());
     if (prescribes_motion())
       for (const unsigned int i : particles)
         system.free[i] = 0.0;
@@ -65,6 +66,15 @@ namespace lacerta::scene
                     " was removed by a change of the level of detail.");
     std::sort(renamed.begin(), renamed.end());
     initialize(renamed, system);
+  }
+
+
+  std::pair<std::size_t, std::size_t>
+  Constraint::particles_in(const unsigned int begin, const unsigned int end) const
+  {
+    const auto first = std::lower_bound(particles.begin(), particles.end(), begin);
+    const auto last  = std::lower_bound(first, particles.end(), end);
+    return {first - particles.begin(), last - particles.begin()};
   }
 
 

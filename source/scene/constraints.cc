@@ -44,13 +44,16 @@ namespace lacerta::scene
                 const unsigned int begin,
                 const unsigned int end) const override
       {
-        for (const unsigned int i : particles)
-          if (i >= begin && i < end)
-            for (unsigned int d = 0; d < 3; ++d)
-            {
-              x[3 * i + d] = rest[3 * i + d];
-              v[3 * i + d] = 0.0;
-            }
+        const auto [first, last] = particles_in(begin, end);
+        for (std::size_t k = first; k < last; ++k)
+        {
+          const unsigned int i = particles[k];
+          for (unsigned int d = 0; d < 3; ++d)
+          {
+            x[3 * i + d] = rest[3 * i + d];
+            v[3 * i + d] = 0.0;
+          }
+        }
       }
     };
 
@@ -134,12 +137,11 @@ namespace lacerta::scene
                 const unsigned int begin,
                 const unsigned int end) const override
       {
-        for (std::size_t k = 0; k < particles.size(); ++k)
+        const auto [first, last] = particles_in(begin, end);
+        for (std::size_t k = first; k < last; ++k)
         {
-          const unsigned int i = particles[k];
-          if (i < begin || i >= end)
-            continue;
-          const std::size_t from = rigid_translation ? 0 : 3 * k;
+          const unsigned int i    = particles[k];
+          const std::size_t  from = rigid_translation ? 0 : 3 * k;
           for (unsigned int d = 0; d < 3; ++d)
           {
             x[3 * i + d] = rest[3 * i + d] + offset[from + d];

@@ -104,7 +104,11 @@ namespace lacerta::physics
     std::function<void(double *, double *, unsigned int, unsigned int)>
       prescribe_constraints = [](double *, double *, unsigned int, unsigned int) {};
 
-    /// Wall time spent in compute_acceleration() since it was last reset (s).
+    /**
+     * Wall time spent in compute_acceleration() since it was last reset (s). It
+     * includes what runs in the force evaluation's parallel pass: the integrator's
+     * update of each range (RangeUpdate) and the constraints' prescription.
+     */
     mutable double force_seconds = 0;
 
     /// Creates @p n_particles particles at rest at @p rest_positions (3 per particle).

@@ -53,7 +53,8 @@ namespace lacerta::postprocess
     unsigned int substeps  = 1;
     /// Energies (J) and the work done by the loads since the start (J).
     double kinetic_energy = 0, elastic_energy = 0, body_force_energy = 0, input_work = 0;
-    /// Wall time of this step's force evaluations and of the whole step (s).
+    /// Wall time of this step's force evaluations (with the integrator's update and the
+    /// constraints done in the same parallel pass) and of the whole step (s).
     double force_seconds = 0, step_seconds = 0;
     /// Cuts of this step (the paper's Table 1): tetrahedra cut and created, and the
     /// wall time of the mesh update (s); all zero in a scene without a tool.

@@ -11,6 +11,7 @@
 #include <array>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace lacerta::physics
@@ -118,7 +119,8 @@ namespace lacerta::scene
 
     /// The instance's name in the parameter file.
     std::string name;
-    /// The particles the constraint acts on.
+    /// The particles the constraint acts on, in increasing order (initialize() sorts
+    /// them).
     std::vector<unsigned int> particles;
 
     /// The region that selects them (again on every level of detail).
@@ -143,6 +145,14 @@ namespace lacerta::scene
      */
     static std::vector<std::unique_ptr<Constraint>>
     create(dealii::ParameterHandler &prm, const mesh::TetMesh &mesh);
+
+  protected:
+    /**
+     * The positions in #particles of the constraint's particles in [@p begin,
+     * @p end): the half-open range of indices into #particles that prescribe() writes.
+     */
+    std::pair<std::size_t, std::size_t>
+    particles_in(unsigned int begin, unsigned int end) const;
   };
 
   /// The registry of constraints.
