@@ -481,15 +481,10 @@ namespace lacerta::mesh
                          tets[bf.tet][face_vertices[bf.face][2]]},
                         bf.boundary_id});
 
-    const std::vector<unsigned int> vertex_order =
-      sorting_permutation(morton_keys(vertices));
-    std::vector<unsigned int> new_index(vertices.size());
-    std::vector<Point3>       new_vertices(vertices.size());
-    for (unsigned int i = 0; i < vertex_order.size(); ++i)
-    {
-      new_index[vertex_order[i]] = i;
-      new_vertices[i]            = vertices[vertex_order[i]];
-    }
+    const std::vector<unsigned int> new_index = spatial_vertex_order();
+    std::vector<Point3>             new_vertices(vertices.size());
+    for (unsigned int v = 0; v < new_index.size(); ++v)
+      new_vertices[new_index[v]] = vertices[v];
     vertices = std::move(new_vertices);
     for (Tet &t : tets)
       for (unsigned int &v : t)
@@ -513,6 +508,70 @@ namespace lacerta::mesh
 
     build_connectivity(tags);
     return new_index;
+  }
+
+
+  std::vector<unsigned int>
+  TetMesh::spatial_vertex_order() const
+  {
+    const std::vector<unsigned int> order = sorting_permutation(morton_keys(vertices));
+    std::vector<unsigned int>       new_index(order.size());
+    for (unsigned int i = 0; i < order.size(); ++i)
+      new_index[order[i]] = i;
+    return new_index;
+  }
+
+
+  double
+  TetMesh::index_spread(const std::vector<unsigned int> &new_index) const
+  {
+    double sum = 0;
+    for (const auto &[a, b] : edges)
+      sum += new_index.empty() ? double(b) - double(a)
+                               : std::abs(double(new_index[a]) - double(new_index[b]));
+    return sum;
+  }
+
+
+  void
+  TetMesh::renumber_vertices(const std::vector<unsigned int> &new_index)
+  {
+    const std::size_t n = vertices.size();
+    std::vector<bool> taken(n, false);
+    for (const unsigned int w : new_index)
+    {
+      if (new_index.size() != n || w >= n || taken[w])
+        throw_error("TetMesh::renumber_vertices: the new indices are no permutation of "
+                    "the mesh's ",
+                    n,
+                    " vertices.");
+      taken[w] = true;
+    }
+    std::vector<Point3>       moved(n);
+    std::vector<std::uint8_t> moved_boundary(n);
+    for (std::size_t v = 0; v < n; ++v)
+    {
+      moved[new_index[v]]          = vertices[v];
+      moved_boundary[new_index[v]] = boundary_vertex[v];
+    }
+    vertices        = std::move(moved);
+    boundary_vertex = std::move(moved_boundary);
+    for (Tet &t : tets)
+      for (unsigned int &v : t)
+        v = new_index[v];
+    for (auto &edge : edges)
+    {
+      const unsigned int a = new_index[edge[0]], b = new_index[edge[1]];
+      edge = {{std::min(a, b), std::max(a, b)}};
+    }
+    if (!vertex_tets.empty())
+    {
+      vertex_tets.clear();
+      vertex_tets.resize(n);
+      for (unsigned int t = 0; t < tets.size(); ++t)
+        for (const unsigned int v : tets[t])
+          vertex_tets.insert(v, t);
+    }
   }
 
 

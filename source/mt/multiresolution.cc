@@ -409,7 +409,7 @@ namespace lacerta::mt
   }
 
 
-  const std::vector<std::array<unsigned int, 2>> &
+  const std::vector<unsigned int> &
   Multiresolution::apply_change(physics::TopologyUpdate &topology,
                                 physics::ParticleSystem &system)
   {
@@ -484,18 +484,21 @@ namespace lacerta::mt
     dead.erase(std::unique(dead.begin(), dead.end()), dead.end());
     for (const unsigned int w : dead)
       mesh_vertex_of[vertices[w]] = mesh::invalid_index;
-    vertex_moves = topology.remove_particles(dead);
-    for (const auto &[to, from] : vertex_moves)
-    {
-      vertices[to]                 = vertices[from];
-      mesh_vertex_of[vertices[to]] = to;
-    }
-    vertices.resize(mesh.n_vertices());
+    topology.remove_particles(dead);
     // The region swapped keeps its mass: a coarser or finer boundary covers a
     // slightly different volume, and the total stays ∫σ.
     topology.conserve_mass();
+    if (topology.numbering_drifted())
+      topology.restore_spatial_order();
+    const std::vector<unsigned int> &new_index = topology.particle_renumbering();
+    renumbered_vertices.resize(mesh.n_vertices());
+    for (std::size_t i = 0; i < new_index.size(); ++i)
+      if (new_index[i] != mesh::invalid_index)
+        renumbered_vertices[new_index[i]] = vertices[i];
+    vertices.swap(renumbered_vertices);
+    index_mesh_vertices(0);
     topology.notify_force_model();
-    return vertex_moves;
+    return new_index;
   }
 
 

@@ -1,4 +1,5 @@
 #include <lacerta/base/archive.h>
+#include <lacerta/base/exceptions.h>
 #include <lacerta/physics/force_model.h>
 #include <lacerta/physics/particle_system.h>
 
@@ -153,6 +154,37 @@ namespace lacerta::physics
     for (const auto &move : moves)
       if (move[0] < n)
         note_changed(move[0]);
+  }
+
+
+  void
+  ParticleSystem::renumber_particles(const std::vector<unsigned int> &new_index)
+  {
+    if (new_index.size() != n_particles())
+      throw_error("ParticleSystem::renumber_particles: ",
+                  new_index.size(),
+                  " new indices for ",
+                  n_particles(),
+                  " particles.");
+    std::vector<double> moved;
+    for (std::vector<double> *v : {&position, &velocity, &external_force, &rest})
+    {
+      moved.resize(v->size());
+      for (std::size_t i = 0; i < new_index.size(); ++i)
+        for (unsigned int d = 0; d < 3; ++d)
+          moved[3 * std::size_t(new_index[i]) + d] = (*v)[3 * i + d];
+      v->swap(moved);
+    }
+    for (std::vector<double> *v : {&mass, &mass_shift, &free})
+    {
+      moved.resize(v->size());
+      for (std::size_t i = 0; i < new_index.size(); ++i)
+        moved[new_index[i]] = (*v)[i];
+      v->swap(moved);
+    }
+    changed.clear();
+    listed.assign(n_particles(), 0);
+    all_changed = true;
   }
 
 

@@ -3,6 +3,7 @@
 #include <lacerta/physics/topology_update.h>
 
 #include <algorithm>
+#include <numeric>
 
 namespace lacerta::physics
 {
@@ -104,6 +105,7 @@ namespace lacerta::physics
   {
     taken_out    = 0;
     removed_mass = 0;
+    new_index.clear();
     for (const unsigned int t : removed)
       add_cell_terms(t, -1, nullptr);
   }
@@ -184,9 +186,10 @@ namespace lacerta::physics
   }
 
 
-  const std::vector<std::array<unsigned int, 2>> &
+  const std::vector<unsigned int> &
   TopologyUpdate::remove_particles(const std::vector<unsigned int> &dead)
   {
+    const unsigned int n_before = system.n_particles();
     // What the particles still hold (rounding, earlier corrections of
     // conserve_mass()) leaves with them; a redistributed share (mass_shift) is the
     // mass balancer's to settle.
@@ -213,13 +216,61 @@ namespace lacerta::physics
             changed_springs.push_back(e);
           }
     }
-    return vertex_moves;
+    // Where every particle went: follow the moves slot by slot.
+    std::vector<unsigned int> occupant(n_before);
+    std::iota(occupant.begin(), occupant.end(), 0u);
+    for (const auto &[to, from] : vertex_moves)
+      occupant[to] = occupant[from];
+    new_index.assign(n_before, mesh::invalid_index);
+    for (unsigned int slot = 0; slot < system.n_particles(); ++slot)
+      new_index[occupant[slot]] = slot;
+    return new_index;
+  }
+
+
+  bool
+  TopologyUpdate::numbering_drifted() const
+  {
+    return mesh.index_spread() > 1.25 * mesh.index_spread(mesh.spatial_vertex_order());
+  }
+
+
+  void
+  TopologyUpdate::restore_spatial_order()
+  {
+    const std::vector<unsigned int> order = mesh.spatial_vertex_order();
+    mesh.renumber_vertices(order);
+    system.renumber_particles(order);
+    SpringSet  &springs = system.springs;
+    const auto &edges   = mesh.get_edges();
+    for (std::size_t e = 0; e < springs.size(); ++e)
+    {
+      springs.a[e] = edges[e][0];
+      springs.b[e] = edges[e][1];
+    }
+    if (new_index.empty())
+    {
+      new_index.resize(order.size());
+      std::iota(new_index.begin(), new_index.end(), 0u);
+    }
+    for (unsigned int &i : new_index)
+      if (i != mesh::invalid_index)
+        i = order[i];
+    touched.clear();
+    changed_springs.clear();
+    renumbered = true;
   }
 
 
   void
   TopologyUpdate::notify_force_model()
   {
+    if (renumbered)
+    {
+      system.refresh_force_model();
+      renumbered = false;
+      return;
+    }
     if (changed_springs.empty())
       return;
     system.springs_changed(changed_springs);

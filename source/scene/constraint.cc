@@ -7,7 +7,6 @@
 #include <deal.II/base/utilities.h>
 
 #include <algorithm>
-#include <unordered_map>
 
 namespace lacerta::scene
 {
@@ -38,33 +37,22 @@ namespace lacerta::scene
 
 
   void
-  Constraint::follow_moves(const std::vector<std::array<unsigned int, 2>> &moves,
-                           physics::ParticleSystem                        &system)
+  Constraint::follow_renumbering(const std::vector<unsigned int> &new_index,
+                                 physics::ParticleSystem         &system)
   {
-    // Where each of the constraint's particles is in the list, followed move by move
-    // (a particle can move twice).
-    std::unordered_map<unsigned int, std::size_t> place;
-    for (std::size_t i = 0; i < particles.size(); ++i)
-      place[particles[i]] = i;
     std::vector<unsigned int> renamed = particles;
-    for (const auto &[to, from] : moves)
+    for (unsigned int &p : renamed)
     {
-      const auto found = place.find(from);
-      if (found == place.end())
-        continue;
-      const std::size_t i = found->second;
-      place.erase(found);
-      renamed[i] = to;
-      place[to]  = i;
-    }
-    for (const unsigned int p : renamed)
-      if (p >= system.n_particles())
+      if (!new_index.empty()
+          && (p >= new_index.size() || new_index[p] >= system.n_particles()))
         throw_error("Constraint '",
                     name,
                     "': internal error, its particle ",
                     p,
                     " was removed by a change of the level of detail.");
-    std::sort(renamed.begin(), renamed.end());
+      if (!new_index.empty())
+        p = new_index[p];
+    }
     initialize(renamed, system);
   }
 

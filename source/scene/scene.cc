@@ -214,7 +214,7 @@ namespace lacerta::scene
   }
 
 
-  const std::vector<std::array<unsigned int, 2>> &
+  const std::vector<unsigned int> &
   Scene::move_to_level_of_detail(const double t)
   {
     if (!level_update)
@@ -224,15 +224,15 @@ namespace lacerta::scene
                                                   material.density(),
                                                   material.youngs_modulus(),
                                                   level_mass_scale);
-    const double volume_before = level_update->volume_delta();
-    const std::vector<std::array<unsigned int, 2>> &moves =
+    const double                     volume_before = level_update->volume_delta();
+    const std::vector<unsigned int> &new_index =
       multiresolution->apply_change(*level_update, *system);
     level_of_detail_volume += level_update->volume_delta() - volume_before;
     for (auto &constraint : constraints)
-      constraint->follow_moves(moves, *system);
+      constraint->follow_renumbering(new_index, *system);
     system->enforce_constraints(t, system->position.data(), system->velocity.data());
     update_loads(t);
-    return moves;
+    return new_index;
   }
 
 
@@ -356,11 +356,11 @@ namespace lacerta::scene
       return false;
     if (!multiresolution->update(t, step, cutter ? &cutter->blade() : nullptr))
       return false;
-    const std::vector<std::array<unsigned int, 2>> &moves = move_to_level_of_detail(t);
+    const std::vector<unsigned int> &new_index = move_to_level_of_detail(t);
     multiresolution->print_change(
       out, t, std::accumulate(system->mass.begin(), system->mass.end(), 0.0));
     SystemChange change{SystemChange::Cause::level_of_detail, t};
-    change.particle_moves = &moves;
+    change.particle_renumbering = &new_index;
     system_changed(change);
     return true;
   }

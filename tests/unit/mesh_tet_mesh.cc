@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cut_split_support.h"
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -137,6 +138,63 @@ TEST(TetMesh, SpatialSortKeepsGeometryAndBoundaryIds)
     tagged += (bf.boundary_id == 7);
   EXPECT_EQ(tagged, 1u);
   EXPECT_EQ(mesh.n_vertices(), 6u); // unused input vertices are dropped
+}
+
+
+// Renumbering the vertices of a mesh whose numbering has no relation to the geometry
+// along the spatial order keeps every cell, edge, star and boundary flag with its
+// vertices, and brings the ends of the edges closer in memory.
+TEST(TetMesh, RenumberingVerticesKeepsTheMeshAndRestoresLocality)
+{
+  std::mt19937 rng(3);
+  TetMesh      mesh = cut::test_support::box_tet_mesh(6, rng);
+  mesh.enable_local_updates();
+  const TetMesh                   before = mesh;
+  const std::vector<unsigned int> order  = mesh.spatial_vertex_order();
+  const double                    spread = mesh.index_spread();
+  mesh.renumber_vertices(order);
+  EXPECT_EQ(mesh.index_spread(), before.index_spread(order));
+  EXPECT_LT(mesh.index_spread(), 0.5 * spread);
+  // The spatial order of a spatially ordered mesh is the identity.
+  const std::vector<unsigned int> again = mesh.spatial_vertex_order();
+  for (unsigned int v = 0; v < again.size(); ++v)
+    ASSERT_EQ(again[v], v);
+
+  ASSERT_EQ(mesh.n_vertices(), before.n_vertices());
+  ASSERT_EQ(mesh.n_tets(), before.n_tets());
+  for (unsigned int v = 0; v < before.n_vertices(); ++v)
+  {
+    EXPECT_EQ(mesh.vertex(order[v]), before.vertex(v));
+    EXPECT_EQ(mesh.is_boundary_vertex(order[v]), before.is_boundary_vertex(v));
+    std::vector<unsigned int> star(mesh.tets_of_vertex(order[v]).begin(),
+                                   mesh.tets_of_vertex(order[v]).end()),
+      old_star(before.tets_of_vertex(v).begin(), before.tets_of_vertex(v).end());
+    std::sort(star.begin(), star.end());
+    std::sort(old_star.begin(), old_star.end());
+    EXPECT_EQ(star, old_star) << "vertex " << v;
+  }
+  for (unsigned int t = 0; t < before.n_tets(); ++t)
+  {
+    for (unsigned int k = 0; k < 4; ++k)
+      EXPECT_EQ(mesh.tet(t)[k], order[before.tet(t)[k]]);
+    EXPECT_EQ(mesh.tet_edges(t), before.tet_edges(t));
+  }
+  for (std::size_t e = 0; e < before.get_edges().size(); ++e)
+  {
+    const auto &[a, b]                         = before.get_edges()[e];
+    const std::array<unsigned int, 2> expected = {
+      {std::min(order[a], order[b]), std::max(order[a], order[b])}};
+    EXPECT_EQ(mesh.get_edges()[e], expected);
+  }
+  EXPECT_EQ(mesh.find_edge(order[before.get_edges()[0][1]],
+                           order[before.get_edges()[0][0]]),
+            0u);
+  EXPECT_NEAR(mesh.total_volume(), before.total_volume(), 1e-14);
+
+  std::vector<unsigned int> twice = order;
+  twice[1]                        = twice[0];
+  EXPECT_THROW(mesh.renumber_vertices(twice), Error);
+  EXPECT_THROW(mesh.renumber_vertices({0, 1}), Error);
 }
 
 

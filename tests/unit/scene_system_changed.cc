@@ -60,7 +60,7 @@ namespace lacerta
         // The scene's own subscriber ran first: the cutter works on the current mesh.
         ASSERT_TRUE(scene->cutter);
         // Only a change of level removes (and so renumbers) particles.
-        EXPECT_EQ(c.particle_moves != nullptr, c.cause == Cause::level_of_detail);
+        EXPECT_EQ(c.particle_renumbering != nullptr, c.cause == Cause::level_of_detail);
         EXPECT_FALSE(c.describe().empty());
         // What the change did comes with it, for its cause only.
         EXPECT_EQ(c.cut != nullptr, c.cause == Cause::cut);

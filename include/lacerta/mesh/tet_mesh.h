@@ -199,6 +199,31 @@ namespace lacerta::mesh
     sort_spatially();
 
     /**
+     * The new index of every vertex along the space-filling (Morton) curve of the
+     * vertices' positions, the order sort_spatially() gives (ties keep the current
+     * order).
+     */
+    std::vector<unsigned int>
+    spatial_vertex_order() const;
+
+    /**
+     * The sum over the edges of the difference of their ends' indices, under the
+     * numbering @p new_index (new index of every vertex; the current numbering if
+     * empty): how far apart in memory the particles that springs join are.
+     */
+    double
+    index_spread(const std::vector<unsigned int> &new_index = {}) const;
+
+    /**
+     * Gives every vertex v the index @p new_index[v] (a permutation of the vertices),
+     * in its tetrahedra and edges (an edge's ends stay ordered) and in the local
+     * updates' stars. Tetrahedra, edges and boundary faces keep their ids. Costs one
+     * pass over the mesh.
+     */
+    void
+    renumber_vertices(const std::vector<unsigned int> &new_index);
+
+    /**
      * What replace_tets() did to the ids, so that arrays indexed by edge or by
      * tetrahedron (the springs, a force model's per-cell data) can follow: first
      * `n_added_edges` edges were appended, then every pair (to, from) of `edge_moves`,

@@ -94,10 +94,12 @@ namespace lacerta::mt
      * (TopologyUpdate::conserve_mass()). A vertex that comes gets its
      * state interpolated in the previous level's tetrahedron that contains it
      * (Lod::locate_in_previous(), barycentric coordinates clamped to it, Section 4.2).
-     * Returns the moves (to, from) of the particles renumbered into freed slots, in
-     * order (TetMesh::remove_vertices()).
+     * Particles are renumbered: the last ones move into freed slots and, when the
+     * numbering has drifted from the spatial order a new level has, all of them are
+     * put back in that order (TopologyUpdate::numbering_drifted()). Returns the new
+     * index of every particle (TopologyUpdate::particle_renumbering()).
      */
-    const std::vector<std::array<unsigned int, 2>> &
+    const std::vector<unsigned int> &
     apply_change(physics::TopologyUpdate &topology, physics::ParticleSystem &system);
 
     /// The cells the last apply_change() removed and added (their sum).
@@ -267,7 +269,7 @@ namespace lacerta::mt
     std::vector<mesh::Tet>                   added;
     std::vector<std::array<double, 6>>       added_stiffness;
     std::vector<std::array<unsigned int, 4>> face_ids;
-    std::vector<std::array<unsigned int, 2>> vertex_moves;
+    std::vector<std::uint32_t>               renumbered_vertices;
     std::size_t                              n_kept = 0, n_new = 0;
   };
 } // namespace lacerta::mt

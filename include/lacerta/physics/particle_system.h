@@ -195,6 +195,15 @@ namespace lacerta::physics
                      unsigned int                                    n_removed);
 
     /**
+     * Gives every particle i the index @p new_index[i] (a permutation, as
+     * TetMesh::renumber_vertices() gave their vertices): its state, rest position,
+     * mass and constraint flag move with it. The springs are the caller's (they follow
+     * the mesh's edges). Every particle counts as changed (all_particles_changed()).
+     */
+    void
+    renumber_particles(const std::vector<unsigned int> &new_index);
+
+    /**
      * The particles whose springs, mass or existence changed locally since
      * clear_changes(), each once, in the order first reported: the ends of the springs
      * passed to springs_changed() (the particles whose tetrahedra changed are among

@@ -30,7 +30,9 @@ namespace lacerta::physics
    * A change is made of these stages, in this order: take_out() of the cells that go
    * (while the mesh still has them), any new particles (the caller adds them to both
    * the mesh and the system), replace(), then remove_particles() of the vertices
-   * left without cells, and notify_force_model().
+   * left without cells, restore_spatial_order() if numbering_drifted() (a change of
+   * the level of detail, whose subscribers follow particle_renumbering()), and
+   * notify_force_model().
    */
   class TopologyUpdate
   {
@@ -78,14 +80,49 @@ namespace lacerta::physics
     /**
      * Removes the vertices @p dead (held by no cell any more) from the mesh and their
      * particles from the system (TetMesh::remove_vertices()); the springs of the
-     * particles moved into the freed slots take their new ends. Returns the moves
-     * (to, from), in order, which arrays by particle held elsewhere follow.
+     * particles moved into the freed slots take their new ends. Returns
+     * particle_renumbering().
      */
-    const std::vector<std::array<unsigned int, 2>> &
+    const std::vector<unsigned int> &
     remove_particles(const std::vector<unsigned int> &dead);
 
+    /**
+     * Whether the particles' numbering has drifted so far from the spatial order
+     * (TetMesh::spatial_vertex_order()) that it should be restored: the springs'
+     * ends lie a quarter further apart in memory (TetMesh::index_spread()) than in
+     * that order. Particles added at the end and moved into freed slots by local
+     * changes scatter what is close in space over the threads' ranges, whose springs
+     * across two ranges are evaluated twice; the order of a new mesh is restored then,
+     * at the cost of one evaluation of the whole system.
+     */
+    bool
+    numbering_drifted() const;
+
+    /**
+     * Renumbers the mesh's vertices and the system's particles along the spatial
+     * order (TetMesh::spatial_vertex_order()), with the springs' ends;
+     * notify_force_model() then prepares the force model for all springs, and every
+     * particle counts as changed. particle_renumbering() includes it.
+     */
+    void
+    restore_spatial_order();
+
+    /**
+     * The index of every particle the system held before this change's
+     * remove_particles() (those the change added included) after it and any
+     * restore_spatial_order(), or mesh::invalid_index for a removed one; empty if no
+     * particle changed its index since take_out(). Arrays by particle held elsewhere
+     * follow it.
+     */
+    const std::vector<unsigned int> &
+    particle_renumbering() const
+    {
+      return new_index;
+    }
+
     /// Passes the springs changed since the last call to the system's force model
-    /// (ParticleSystem::springs_changed()); does nothing if none changed.
+    /// (ParticleSystem::springs_changed()), or all of them after
+    /// restore_spatial_order(); does nothing if none changed.
     void
     notify_force_model();
 
@@ -154,7 +191,12 @@ namespace lacerta::physics
     mesh::TetMesh::Update                    update_of_mesh;
     std::vector<unsigned int>                added_ids, touched, changed_springs;
     std::vector<std::array<unsigned int, 2>> vertex_moves;
-    double                                   delta = 0, volume_change = 0;
+    /// See particle_renumbering().
+    std::vector<unsigned int> new_index;
+    /// Whether restore_spatial_order() renumbered the particles since
+    /// notify_force_model().
+    bool   renumbered = false;
+    double delta = 0, volume_change = 0;
     /// The masses the last take_out() took out and the last replace() put in (kg).
     double taken_out = 0, put_in = 0;
     /// The lumped masses the particles removed since the last take_out() held (kg).

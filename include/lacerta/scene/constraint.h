@@ -70,14 +70,14 @@ namespace lacerta::scene
                   physics::ParticleSystem                        &system);
 
     /**
-     * Follows particles renumbered into freed slots (@p moves: (to, from) in order,
-     * ParticleSystem::remove_particles()) and initialises the constraint again (a new
-     * level of detail changed the masses). Its particles are never among the removed
-     * ones: the MT never removes a constrained vertex.
+     * Follows renumbered particles (@p new_index: the new index of every particle,
+     * TopologyUpdate::particle_renumbering(); nothing if empty) and initialises the
+     * constraint again (a new level of detail changed the masses). Its particles are
+     * never among the removed ones: the MT never removes a constrained vertex.
      */
     void
-    follow_moves(const std::vector<std::array<unsigned int, 2>> &moves,
-                 physics::ParticleSystem                        &system);
+    follow_renumbering(const std::vector<unsigned int> &new_index,
+                       physics::ParticleSystem         &system);
 
     /// Whether the constraint prescribes the motion of its particles.
     virtual bool

@@ -240,10 +240,10 @@ namespace lacerta::scene
      * Moves the particle system to the level of detail the last extraction chose, at
      * time @p t, locally (Multiresolution::apply_change() through `level_update`, the
      * update a cut makes): the mass of the swapped region is kept, the constraints
-     * follow the renumbered particles and are enforced. Returns the particles' moves
-     * (SystemChange::particle_moves).
+     * follow the renumbered particles and are enforced. Returns the particles' new
+     * indices (SystemChange::particle_renumbering).
      */
-    const std::vector<std::array<unsigned int, 2>> &
+    const std::vector<unsigned int> &
     move_to_level_of_detail(double t);
 
     /// The mesh the cutter cuts: the level of detail's, or the mesh.

@@ -50,12 +50,13 @@ namespace lacerta::scene
     copied_particles() const;
 
     /**
-     * A change of the level of detail removes particles: every pair (to, from), in
-     * order, moved particle `from` into the freed slot `to`
-     * (ParticleSystem::remove_particles()). Subscribers that keep particle ids follow
-     * them; nullptr for a cut or a tear, which only add particles.
+     * A change of the level of detail removes particles and may renumber all of them:
+     * the new index of every particle, or mesh::invalid_index for a removed one
+     * (TopologyUpdate::particle_renumbering(); empty if none changed its index).
+     * Subscribers that keep particle ids follow it; nullptr for a cut or a tear, which
+     * only add particles.
      */
-    const std::vector<std::array<unsigned int, 2>> *particle_moves = nullptr;
+    const std::vector<unsigned int> *particle_renumbering = nullptr;
 
     /// The cause in words, for messages: "the cut", "the laceration", ...
     std::string
