@@ -536,15 +536,21 @@ namespace lacerta::mesh
   void
   TetMesh::renumber_vertices(const std::vector<unsigned int> &new_index)
   {
-    const std::size_t n = vertices.size();
+    const std::size_t n      = vertices.size();
+    const auto        refuse = [n]()
+    {
+      throw_error("TetMesh::renumber_vertices: the new indices are no permutation of "
+                  "the mesh's ",
+                  n,
+                  " vertices.");
+    };
+    if (new_index.size() != n)
+      refuse();
     std::vector<bool> taken(n, false);
     for (const unsigned int w : new_index)
     {
-      if (new_index.size() != n || w >= n || taken[w])
-        throw_error("TetMesh::renumber_vertices: the new indices are no permutation of "
-                    "the mesh's ",
-                    n,
-                    " vertices.");
+      if (w >= n || taken[w])
+        refuse();
       taken[w] = true;
     }
     std::vector<Point3>       moved(n);

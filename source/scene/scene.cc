@@ -134,7 +134,7 @@ namespace lacerta::scene
   void
   Scene::follow_change(const SystemChange &change)
   {
-    // A change of level has made the constraints follow its moves already.
+    // A change of level has made the constraints follow its renumbering already.
     if (change.cause != SystemChange::Cause::level_of_detail)
       for (auto &constraint : constraints)
         constraint->follow_copies(change.copied_particles(), *system);

@@ -195,6 +195,7 @@ TEST(TetMesh, RenumberingVerticesKeepsTheMeshAndRestoresLocality)
   twice[1]                        = twice[0];
   EXPECT_THROW(mesh.renumber_vertices(twice), Error);
   EXPECT_THROW(mesh.renumber_vertices({0, 1}), Error);
+  EXPECT_THROW(mesh.renumber_vertices({}), Error);
 }
 
 
