@@ -110,8 +110,8 @@ namespace lacerta::physics
     /**
      * The index of every particle the system held before this change's
      * remove_particles() (those the change added included) after it and any
-     * restore_spatial_order(), or mesh::invalid_index for a removed one; empty if no
-     * particle changed its index since take_out(). Arrays by particle held elsewhere
+     * restore_spatial_order(), or mesh::invalid_index for a removed one; empty from
+     * take_out() until one of those two is called. Arrays by particle held elsewhere
      * follow it.
      */
     const std::vector<unsigned int> &

@@ -52,7 +52,7 @@ namespace lacerta::scene
     /**
      * A change of the level of detail removes particles and may renumber all of them:
      * the new index of every particle, or mesh::invalid_index for a removed one
-     * (TopologyUpdate::particle_renumbering(); empty if none changed its index).
+     * (TopologyUpdate::particle_renumbering(); the identity where nothing moved).
      * Subscribers that keep particle ids follow it; nullptr for a cut or a tear, which
      * only add particles.
      */
