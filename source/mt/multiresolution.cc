@@ -488,8 +488,7 @@ namespace lacerta::mt
     // The region swapped keeps its mass: a coarser or finer boundary covers a
     // slightly different volume, and the total stays ∫σ.
     topology.conserve_mass();
-    if (topology.numbering_drifted())
-      topology.restore_spatial_order();
+    topology.restore_spatial_order();
     const std::vector<unsigned int> &new_index = topology.particle_renumbering();
     renumbered_vertices.resize(mesh.n_vertices());
     for (std::size_t i = 0; i < new_index.size(); ++i)

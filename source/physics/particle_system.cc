@@ -124,21 +124,15 @@ namespace lacerta::physics
   ParticleSystem::remove_particles(const std::vector<std::array<unsigned int, 2>> &moves,
                                    const unsigned int n_removed)
   {
-    for (const auto &[to, from] : moves)
-    {
-      for (std::vector<double> *v : {&position, &velocity, &external_force, &rest})
-        for (unsigned int d = 0; d < 3; ++d)
-          (*v)[3 * std::size_t(to) + d] = (*v)[3 * std::size_t(from) + d];
-      mass[to]       = mass[from];
-      mass_shift[to] = mass_shift[from];
-      free[to]       = free[from];
-    }
     const std::size_t n = n_particles() - std::size_t(n_removed);
-    for (std::vector<double> *v : {&position, &velocity, &external_force, &rest})
-      v->resize(3 * n);
-    mass.resize(n);
-    mass_shift.resize(n);
-    free.resize(n);
+    for_each_particle_array(
+      [&](std::vector<double> &values, const unsigned int width)
+      {
+        for (const auto &[to, from] : moves)
+          for (unsigned int d = 0; d < width; ++d)
+            values[width * std::size_t(to) + d] = values[width * std::size_t(from) + d];
+        values.resize(width * n);
+      });
     if (all_changed)
       return;
     // A slot that was listed and refilled holds a moved particle, which is listed
@@ -167,24 +161,29 @@ namespace lacerta::physics
                   n_particles(),
                   " particles.");
     std::vector<double> moved;
-    for (std::vector<double> *v : {&position, &velocity, &external_force, &rest})
-    {
-      moved.resize(v->size());
-      for (std::size_t i = 0; i < new_index.size(); ++i)
-        for (unsigned int d = 0; d < 3; ++d)
-          moved[3 * std::size_t(new_index[i]) + d] = (*v)[3 * i + d];
-      v->swap(moved);
-    }
-    for (std::vector<double> *v : {&mass, &mass_shift, &free})
-    {
-      moved.resize(v->size());
-      for (std::size_t i = 0; i < new_index.size(); ++i)
-        moved[new_index[i]] = (*v)[i];
-      v->swap(moved);
-    }
+    for_each_particle_array(
+      [&](std::vector<double> &values, const unsigned int width)
+      {
+        moved.resize(values.size());
+        for (std::size_t i = 0; i < new_index.size(); ++i)
+          for (unsigned int d = 0; d < width; ++d)
+            moved[width * std::size_t(new_index[i]) + d] = values[width * i + d];
+        values.swap(moved);
+      });
     changed.clear();
     listed.assign(n_particles(), 0);
     all_changed = true;
+  }
+
+
+  template <typename Function>
+  void
+  ParticleSystem::for_each_particle_array(const Function &f)
+  {
+    for (std::vector<double> *v : {&position, &velocity, &external_force, &rest})
+      f(*v, 3u);
+    for (std::vector<double> *v : {&mass, &mass_shift, &free})
+      f(*v, 1u);
   }
 
 

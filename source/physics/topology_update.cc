@@ -229,16 +229,11 @@ namespace lacerta::physics
 
 
   bool
-  TopologyUpdate::numbering_drifted() const
-  {
-    return mesh.index_spread() > 1.25 * mesh.index_spread(mesh.spatial_vertex_order());
-  }
-
-
-  void
   TopologyUpdate::restore_spatial_order()
   {
     const std::vector<unsigned int> order = mesh.spatial_vertex_order();
+    if (!(mesh.index_spread() > 1.25 * mesh.index_spread(order)))
+      return false;
     mesh.renumber_vertices(order);
     system.renumber_particles(order);
     SpringSet  &springs = system.springs;
@@ -259,6 +254,7 @@ namespace lacerta::physics
     touched.clear();
     changed_springs.clear();
     renumbered = true;
+    return true;
   }
 
 

@@ -96,7 +96,7 @@ namespace lacerta::mt
      * (Lod::locate_in_previous(), barycentric coordinates clamped to it, Section 4.2).
      * Particles are renumbered: the last ones move into freed slots and, when the
      * numbering has drifted from the spatial order a new level has, all of them are
-     * put back in that order (TopologyUpdate::numbering_drifted()). Returns the new
+     * put back in that order (TopologyUpdate::restore_spatial_order()). Returns the new
      * index of every particle (TopologyUpdate::particle_renumbering()).
      */
     const std::vector<unsigned int> &

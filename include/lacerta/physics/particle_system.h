@@ -293,6 +293,12 @@ namespace lacerta::physics
     }
 
   private:
+    /// Calls @p f(array, values per particle) for every array by particle: the state,
+    /// loads, rest positions, masses and constraint flags.
+    template <typename Function>
+    void
+    for_each_particle_array(const Function &f);
+
     std::vector<double>         rest;
     std::unique_ptr<ForceModel> forces;
     unsigned int                force_threads = 1;

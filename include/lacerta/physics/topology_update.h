@@ -30,9 +30,8 @@ namespace lacerta::physics
    * A change is made of these stages, in this order: take_out() of the cells that go
    * (while the mesh still has them), any new particles (the caller adds them to both
    * the mesh and the system), replace(), then remove_particles() of the vertices
-   * left without cells, restore_spatial_order() if numbering_drifted() (a change of
-   * the level of detail, whose subscribers follow particle_renumbering()), and
-   * notify_force_model().
+   * left without cells, restore_spatial_order() (a change of the level of detail,
+   * whose subscribers follow particle_renumbering()), and notify_force_model().
    */
   class TopologyUpdate
   {
@@ -87,24 +86,18 @@ namespace lacerta::physics
     remove_particles(const std::vector<unsigned int> &dead);
 
     /**
-     * Whether the particles' numbering has drifted so far from the spatial order
-     * (TetMesh::spatial_vertex_order()) that it should be restored: the springs'
-     * ends lie a quarter further apart in memory (TetMesh::index_spread()) than in
-     * that order. Particles added at the end and moved into freed slots by local
+     * If the particles' numbering has drifted far from the spatial order
+     * (TetMesh::spatial_vertex_order()), the springs' ends lying a quarter further
+     * apart in memory (TetMesh::index_spread()) than in that order, renumbers the
+     * mesh's vertices and the system's particles along it, with the springs' ends;
+     * notify_force_model() then prepares the force model for all springs, and every
+     * particle counts as changed. particle_renumbering() includes it. Returns whether
+     * it renumbered. Particles added at the end and moved into freed slots by local
      * changes scatter what is close in space over the threads' ranges, whose springs
      * across two ranges are evaluated twice; the order of a new mesh is restored then,
      * at the cost of one evaluation of the whole system.
      */
     bool
-    numbering_drifted() const;
-
-    /**
-     * Renumbers the mesh's vertices and the system's particles along the spatial
-     * order (TetMesh::spatial_vertex_order()), with the springs' ends;
-     * notify_force_model() then prepares the force model for all springs, and every
-     * particle counts as changed. particle_renumbering() includes it.
-     */
-    void
     restore_spatial_order();
 
     /**
